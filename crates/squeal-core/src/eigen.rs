@@ -1,0 +1,315 @@
+//! The [`EigenSolver`] plugin trait and the symmetric (real-mode) problem.
+//!
+//! Normal modes solve `K x = omega^2 M x` with `K` symmetric positive semi-definite and
+//! `M` symmetric positive definite, on the free DOFs. Every backend works on the same
+//! [`ShiftInvert`] operator `(K - sigma M)^-1 M` (shift below the spectrum, one Cholesky
+//! factorization) through the [`SymmetricKernel`] trait; the band logic, the
+//! back-transformation, the normalization and the residuals are written once, in
+//! [`solve_symmetric_band`], so backends differ only in their Krylov iteration.
+//!
+//! Residual of a pair: `||K x - omega^2 M x|| / ((||K||_1 + omega^2 ||M||_1) ||x||)`,
+//! a relative backward error.
+
+use crate::linalg::{norm1, norm2, spmv, ShiftInvert};
+use crate::{Error, Result, SparseRef};
+use faer::Mat;
+use std::time::Instant;
+
+/// `K x = omega^2 M x` on the free DOFs.
+#[derive(Clone, Copy)]
+pub struct SymmetricProblem<'a> {
+    /// Stiffness (N/m), symmetric positive semi-definite.
+    pub k: SparseRef<'a>,
+    /// Mass (kg), symmetric positive definite.
+    pub m: SparseRef<'a>,
+}
+
+/// What to compute and how precisely.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EigenParams {
+    /// Band bottom (Hz): modes below are dropped from the result.
+    pub fmin_hz: f64,
+    /// Band top (Hz): every mode up to here is returned.
+    pub fmax_hz: f64,
+    /// Relative convergence tolerance of the Ritz pairs.
+    pub tol: f64,
+    /// Cap on restarts (or Arnoldi/Lanczos update iterations) of one Krylov run.
+    pub max_restarts: usize,
+    /// Shift (Hz) used as `sigma = -(2 pi shift_hz)^2`; `None` picks `fmax_hz / 20`.
+    pub shift_hz: Option<f64>,
+    /// First guess of how many modes lie below `fmax_hz` (grown automatically).
+    pub nev_hint: Option<usize>,
+    /// Problems up to this size are solved densely (reported in the notes).
+    pub dense_below: usize,
+}
+
+impl Default for EigenParams {
+    fn default() -> Self {
+        Self {
+            fmin_hz: 0.0,
+            fmax_hz: 10_000.0,
+            tol: 1e-12,
+            max_restarts: 300,
+            shift_hz: None,
+            nev_hint: None,
+            dense_below: 120,
+        }
+    }
+}
+
+/// Why a solve stopped.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum StopReason {
+    /// All requested pairs met the tolerance.
+    Converged,
+    /// The iteration cap was hit; `converged` in [`SolveInfo`] says how many made it.
+    MaxIterations,
+}
+
+/// Cost and convergence report attached to every solve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolveInfo {
+    /// Backend name.
+    pub solver: String,
+    /// Wall time (s), factorizations included.
+    pub time_s: f64,
+    /// Pairs requested in the last Krylov run.
+    pub requested: usize,
+    /// Pairs converged in the last Krylov run.
+    pub converged: usize,
+    /// Restarts / update iterations, summed over runs.
+    pub iterations: usize,
+    /// Operator applications (one sparse solve each).
+    pub op_applications: usize,
+    /// Sparse factorizations performed.
+    pub factorizations: usize,
+    /// Why it stopped.
+    pub reason: StopReason,
+    /// Anything the user should know (fallbacks, enlarged requests).
+    pub notes: Vec<String>,
+}
+
+/// Real normal modes in a band, sorted by frequency.
+#[derive(Debug, Clone)]
+pub struct RealModes {
+    /// Eigenvalues `omega^2`, (rad/s)^2.
+    pub omega2: Vec<f64>,
+    /// Frequencies (Hz); negative round-off eigenvalues give 0.
+    pub freq_hz: Vec<f64>,
+    /// Mode shapes on the free DOFs, one column per mode, `M`-orthonormal.
+    pub vectors: Mat<f64>,
+    /// Relative residual of each pair (see module docs).
+    pub residuals: Vec<f64>,
+    /// How the solve went.
+    pub info: SolveInfo,
+}
+
+/// Output of a [`SymmetricKernel`]: the largest eigenvalues of the shift-invert operator.
+#[derive(Debug, Clone)]
+pub struct KernelOutput {
+    /// Converged operator eigenvalues `theta`, any order.
+    pub theta: Vec<f64>,
+    /// Matching eigenvectors (columns), any scaling.
+    pub vectors: Mat<f64>,
+    /// Restarts / iterations used.
+    pub iterations: usize,
+    /// Whether every requested pair converged.
+    pub all_converged: bool,
+}
+
+/// A Krylov iteration for the `nev` largest eigenvalues of the `M`-self-adjoint
+/// operator `OP = (K - sigma M)^-1 M`.
+pub trait SymmetricKernel: Send + Sync {
+    /// Computes the `nev` eigenpairs of largest `theta`.
+    fn largest(
+        &self,
+        op: &ShiftInvert<'_>,
+        nev: usize,
+        tol: f64,
+        max_restarts: usize,
+    ) -> Result<KernelOutput>;
+}
+
+/// The eigen solver plugin trait.
+///
+/// First version: real normal modes. The frictional (non-symmetric quadratic) problem
+/// is added with the frictional operator.
+pub trait EigenSolver: Send + Sync {
+    /// Plugin name (as registered).
+    fn name(&self) -> &str;
+    /// All normal modes in `[params.fmin_hz, params.fmax_hz]`.
+    fn solve_symmetric(
+        &self,
+        problem: &SymmetricProblem<'_>,
+        params: &EigenParams,
+    ) -> Result<RealModes>;
+}
+
+/// Band driver shared by all symmetric backends: shift-invert below the spectrum,
+/// run the kernel for `nev` pairs, grow `nev` until a converged mode lies above the
+/// band top, then back-transform, `M`-normalize, compute residuals and sort.
+pub fn solve_symmetric_band(
+    solver: &str,
+    kernel: &dyn SymmetricKernel,
+    problem: &SymmetricProblem<'_>,
+    params: &EigenParams,
+) -> Result<RealModes> {
+    let start = Instant::now();
+    let n = problem.k.nrows();
+    validate_params(params)?;
+    if n == 0 {
+        return Err(Error::Invalid("empty eigenproblem (no free DOFs)".into()));
+    }
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let shift_hz = params.shift_hz.unwrap_or(params.fmax_hz / 20.0).abs();
+    let sigma = -(two_pi * shift_hz).powi(2);
+    let op = ShiftInvert::new(problem.k, problem.m, sigma)?;
+    let mut info = SolveInfo {
+        solver: solver.to_string(),
+        time_s: 0.0,
+        requested: 0,
+        converged: 0,
+        iterations: 0,
+        op_applications: 0,
+        factorizations: 1,
+        reason: StopReason::Converged,
+        notes: Vec::new(),
+    };
+    let top = (two_pi * params.fmax_hz).powi(2);
+
+    let (omega2, vectors) = if n <= params.dense_below {
+        info.notes.push(format!(
+            "n = {n} <= {}: solved densely instead of `{solver}`",
+            params.dense_below
+        ));
+        dense_symmetric(problem)?
+    } else {
+        let mut nev = params.nev_hint.unwrap_or(24).clamp(1, n - 1);
+        loop {
+            let out = kernel.largest(&op, nev, params.tol, params.max_restarts)?;
+            info.iterations += out.iterations;
+            info.requested = nev;
+            info.converged = out.theta.len();
+            if !out.all_converged {
+                info.reason = StopReason::MaxIterations;
+            }
+            let lam: Vec<f64> = out.theta.iter().map(|&t| op.lambda_of_theta(t)).collect();
+            let reached = lam.iter().any(|&l| l > top);
+            if reached || nev >= n - 1 || !out.all_converged {
+                if !reached && nev < n - 1 {
+                    info.notes.push(format!(
+                        "band top not reached: {} of {nev} pairs converged",
+                        out.theta.len()
+                    ));
+                }
+                break (lam, out.vectors);
+            }
+            let grown = (nev * 2).min(n - 1);
+            info.notes
+                .push(format!("{nev} pairs all below the band top; retried with {grown}"));
+            nev = grown;
+        }
+    };
+    info.op_applications = op.applications();
+
+    // Normalize, compute residuals, keep the band, sort.
+    let kn = norm1(problem.k);
+    let mn = norm1(problem.m);
+    let bottom = (two_pi * params.fmin_hz).powi(2);
+    let mut keep: Vec<(f64, usize)> = omega2
+        .iter()
+        .enumerate()
+        .filter(|(_, &l)| l <= top * (1.0 + 1e-12) && (params.fmin_hz <= 0.0 || l >= bottom))
+        .map(|(i, &l)| (l, i))
+        .collect();
+    keep.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut out_vec = Mat::<f64>::zeros(n, keep.len());
+    let mut residuals = Vec::with_capacity(keep.len());
+    let (mut kx, mut mx) = (vec![0.0; n], vec![0.0; n]);
+    for (c, &(l, i)) in keep.iter().enumerate() {
+        let mut x: Vec<f64> = (0..n).map(|r| vectors[(r, i)]).collect();
+        spmv(problem.m, &x, &mut mx);
+        let scale = crate::linalg::dot(&x, &mx).sqrt();
+        if scale > 0.0 {
+            x.iter_mut().for_each(|v| *v /= scale);
+        }
+        spmv(problem.k, &x, &mut kx);
+        spmv(problem.m, &x, &mut mx);
+        let r: Vec<f64> = kx.iter().zip(&mx).map(|(a, b)| a - l * b).collect();
+        residuals.push(norm2(&r) / ((kn + l.abs() * mn) * norm2(&x)));
+        for r in 0..n {
+            out_vec[(r, c)] = x[r];
+        }
+    }
+    let omega2: Vec<f64> = keep.iter().map(|p| p.0).collect();
+    let freq_hz = omega2.iter().map(|&l| l.max(0.0).sqrt() / two_pi).collect();
+    info.time_s = start.elapsed().as_secs_f64();
+    Ok(RealModes {
+        omega2,
+        freq_hz,
+        vectors: out_vec,
+        residuals,
+        info,
+    })
+}
+
+fn validate_params(p: &EigenParams) -> Result<()> {
+    if !(p.fmax_hz.is_finite() && p.fmax_hz > 0.0) {
+        return Err(Error::param(
+            "fmax_hz",
+            format!("band top must be a positive frequency in Hz, got {}", p.fmax_hz),
+        ));
+    }
+    if !(p.fmin_hz.is_finite() && p.fmin_hz >= 0.0 && p.fmin_hz < p.fmax_hz) {
+        return Err(Error::param(
+            "fmin_hz",
+            format!("band bottom must be in [0, {}) Hz, got {}", p.fmax_hz, p.fmin_hz),
+        ));
+    }
+    if !(p.tol > 0.0 && p.tol < 1.0) {
+        return Err(Error::param(
+            "tol",
+            format!("relative tolerance must be in (0, 1), got {}", p.tol),
+        ));
+    }
+    Ok(())
+}
+
+/// Dense solution of the whole symmetric pencil (small problems and oracles):
+/// `M = L L^T`, `L^-1 K L^-T y = lambda y`, `x = L^-T y`.
+pub fn dense_symmetric(problem: &SymmetricProblem<'_>) -> Result<(Vec<f64>, Mat<f64>)> {
+    let n = problem.k.nrows();
+    let k = problem.k.to_dense();
+    let m = problem.m.to_dense();
+    let llt = m.llt(faer::Side::Lower).map_err(|e| Error::Factorization {
+        what: "M (dense)".into(),
+        reason: format!("{e:?}: the mass matrix must be positive definite"),
+    })?;
+    let l = llt.L().to_owned();
+    // A = L^-1 K L^-T
+    let mut a = k.clone();
+    faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+        l.as_ref(),
+        a.as_mut(),
+        faer::Par::Seq,
+    );
+    let mut at = a.transpose().to_owned();
+    faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+        l.as_ref(),
+        at.as_mut(),
+        faer::Par::Seq,
+    );
+    let sym = (&at + at.transpose()) * faer::Scale(0.5);
+    let eig = sym
+        .self_adjoint_eigen(faer::Side::Lower)
+        .map_err(|e| Error::Invalid(format!("dense symmetric eigen failed: {e:?}")))?;
+    let s = eig.S();
+    let lam: Vec<f64> = (0..n).map(|i| s[i]).collect();
+    let mut x = eig.U().to_owned();
+    faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+        l.transpose(),
+        x.as_mut(),
+        faer::Par::Seq,
+    );
+    Ok((lam, x))
+}

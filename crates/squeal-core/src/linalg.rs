@@ -1,0 +1,224 @@
+//! Shared sparse linear algebra: combinations, products, norms and the symmetric
+//! shift-invert operator that every symmetric eigen backend drives.
+//!
+//! The shift-invert operator of the generalized problem `K x = lambda M x` is
+//! `OP = (K - sigma M)^-1 M`. It is self-adjoint in the `M` inner product and its
+//! eigenvalues `theta = 1 / (lambda - sigma)` are largest for the `lambda` nearest
+//! `sigma`. With `sigma` below the spectrum, `K - sigma M` is positive definite and
+//! one sparse Cholesky factorization (faer, AMD ordering) serves every application.
+
+use crate::{Error, Result, SparseMat, SparseRef};
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::Triplet;
+use faer::{MatMut, Side};
+
+/// `alpha A + beta B` for square sparse matrices of the same size (patterns may differ).
+pub fn add_scaled(a: SparseRef<'_>, alpha: f64, b: SparseRef<'_>, beta: f64) -> Result<SparseMat> {
+    if a.nrows() != b.nrows() || a.ncols() != b.ncols() {
+        return Err(Error::Dimension {
+            context: "add_scaled".into(),
+            expected: a.nrows(),
+            got: b.nrows(),
+        });
+    }
+    let mut trip = Vec::with_capacity(a.compute_nnz() + b.compute_nnz());
+    for (m, s) in [(a, alpha), (b, beta)] {
+        for j in 0..m.ncols() {
+            for (i, v) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+                trip.push(Triplet::new(i, j, s * v));
+            }
+        }
+    }
+    SparseMat::try_new_from_triplets(a.nrows(), a.ncols(), &trip)
+        .map_err(|e| Error::Invalid(format!("add_scaled: {e:?}")))
+}
+
+/// `y = A x` (overwrites `y`).
+pub fn spmv(a: SparseRef<'_>, x: &[f64], y: &mut [f64]) {
+    debug_assert_eq!(x.len(), a.ncols());
+    debug_assert_eq!(y.len(), a.nrows());
+    y.iter_mut().for_each(|v| *v = 0.0);
+    for j in 0..a.ncols() {
+        let xj = x[j];
+        if xj == 0.0 {
+            continue;
+        }
+        for (i, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
+            y[i] += v * xj;
+        }
+    }
+}
+
+/// Maximum absolute column sum, `||A||_1`: the scale used by relative residuals.
+pub fn norm1(a: SparseRef<'_>) -> f64 {
+    (0..a.ncols())
+        .map(|j| a.val_of_col(j).iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+/// Euclidean norm.
+pub fn norm2(x: &[f64]) -> f64 {
+    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
+/// Dot product.
+pub fn dot(x: &[f64], y: &[f64]) -> f64 {
+    x.iter().zip(y).map(|(a, b)| a * b).sum()
+}
+
+/// Checks that a matrix is square of size `n` with finite entries.
+pub fn check_square_finite(a: SparseRef<'_>, n: usize, what: &str) -> Result<()> {
+    if a.nrows() != n || a.ncols() != n {
+        return Err(Error::Dimension {
+            context: format!("{what} must be {n} x {n}"),
+            expected: n,
+            got: if a.nrows() != n { a.nrows() } else { a.ncols() },
+        });
+    }
+    for j in 0..n {
+        if a.val_of_col(j).iter().any(|v| !v.is_finite()) {
+            return Err(Error::Invalid(format!(
+                "{what} has a non-finite entry in column {j}"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The factorized symmetric shift-invert operator `OP = (K - sigma M)^-1 M`.
+pub struct ShiftInvert<'a> {
+    m: SparseRef<'a>,
+    sigma: f64,
+    llt: Llt<usize, f64>,
+    applications: std::sync::atomic::AtomicUsize,
+}
+
+impl<'a> ShiftInvert<'a> {
+    /// Factorizes `K - sigma M` (Cholesky). `sigma` must lie below the spectrum so that
+    /// the shifted matrix is positive definite; the error says so otherwise.
+    pub fn new(k: SparseRef<'_>, m: SparseRef<'a>, sigma: f64) -> Result<Self> {
+        let n = k.nrows();
+        check_square_finite(k, n, "K")?;
+        check_square_finite(m, n, "M")?;
+        let shifted = add_scaled(k, 1.0, m, -sigma)?;
+        let fail = |reason: String| Error::Factorization {
+            what: format!("K - sigma M (sigma = {sigma:.6e} (rad/s)^2, n = {n})"),
+            reason,
+        };
+        let symbolic = SymbolicLlt::try_new(shifted.symbolic(), Side::Lower)
+            .map_err(|e| fail(format!("{e:?}")))?;
+        let llt = Llt::try_new_with_symbolic(symbolic, shifted.as_ref(), Side::Lower).map_err(
+            |e| {
+                fail(format!(
+                    "{e:?} (not positive definite: is sigma below the lowest eigenvalue, \
+                     and are the rigid-body motions of K restrained or M positive?)"
+                ))
+            },
+        )?;
+        Ok(Self {
+            m,
+            sigma,
+            llt,
+            applications: std::sync::atomic::AtomicUsize::new(0),
+        })
+    }
+
+    /// Problem size.
+    pub fn dim(&self) -> usize {
+        self.m.nrows()
+    }
+
+    /// The shift `sigma`, in (rad/s)^2.
+    pub fn sigma(&self) -> f64 {
+        self.sigma
+    }
+
+    /// The mass matrix.
+    pub fn m(&self) -> SparseRef<'a> {
+        self.m
+    }
+
+    /// `y = M x`.
+    pub fn m_mul(&self, x: &[f64], y: &mut [f64]) {
+        spmv(self.m, x, y);
+    }
+
+    /// `y <- (K - sigma M)^-1 y`.
+    pub fn solve_in_place(&self, y: &mut [f64]) {
+        let n = y.len();
+        let mat = MatMut::from_column_major_slice_mut(y, n, 1);
+        self.llt.solve_in_place(mat);
+    }
+
+    /// `y = (K - sigma M)^-1 M x`, the operator application.
+    pub fn apply(&self, x: &[f64], y: &mut [f64]) {
+        self.m_mul(x, y);
+        self.solve_in_place(y);
+        self.applications.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// `y = (K - sigma M)^-1 b` where `b = M x` is already known (saves one product).
+    pub fn apply_with_mx(&self, mx: &[f64], y: &mut [f64]) {
+        y.copy_from_slice(mx);
+        self.solve_in_place(y);
+        self.applications.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// How many times the operator was applied (a cost measure reported by solvers).
+    pub fn applications(&self) -> usize {
+        self.applications.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// Back-transforms an operator eigenvalue `theta` to `lambda = sigma + 1 / theta`.
+    pub fn lambda_of_theta(&self, theta: f64) -> f64 {
+        self.sigma + 1.0 / theta
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn diag(v: &[f64]) -> SparseMat {
+        let t: Vec<_> = v
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| Triplet::new(i, i, x))
+            .collect();
+        SparseMat::try_new_from_triplets(v.len(), v.len(), &t).unwrap()
+    }
+
+    #[test]
+    fn shift_invert_on_a_diagonal_pencil() {
+        let k = diag(&[1.0, 4.0, 9.0]);
+        let m = diag(&[1.0, 2.0, 3.0]);
+        let op = ShiftInvert::new(k.as_ref(), m.as_ref(), -1.0).unwrap();
+        let mut y = vec![0.0; 3];
+        op.apply(&[1.0, 1.0, 1.0], &mut y);
+        // (k_i + m_i)^-1 m_i
+        approx::assert_relative_eq!(y[0], 0.5, epsilon = 1e-14);
+        approx::assert_relative_eq!(y[1], 2.0 / 6.0, epsilon = 1e-14);
+        approx::assert_relative_eq!(y[2], 3.0 / 12.0, epsilon = 1e-14);
+        assert_eq!(op.applications(), 1);
+        approx::assert_relative_eq!(op.lambda_of_theta(0.5), 1.0, epsilon = 1e-14);
+    }
+
+    #[test]
+    fn shift_above_spectrum_is_a_clear_error() {
+        let k = diag(&[1.0, 4.0]);
+        let m = diag(&[1.0, 1.0]);
+        let e = ShiftInvert::new(k.as_ref(), m.as_ref(), 2.0)
+            .err()
+            .expect("indefinite shift must fail")
+            .to_string();
+        assert!(e.contains("sigma") && e.contains("positive definite"), "{e}");
+    }
+
+    #[test]
+    fn non_finite_matrix_is_rejected() {
+        let k = diag(&[1.0, f64::NAN]);
+        let m = diag(&[1.0, 1.0]);
+        assert!(ShiftInvert::new(k.as_ref(), m.as_ref(), 0.0).is_err());
+    }
+}

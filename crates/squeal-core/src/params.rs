@@ -1,0 +1,165 @@
+//! Name/value parameters from which plugins are constructed.
+//!
+//! Scene files and the command line (`--basis-opt k=v`) both end up as [`Params`]; a plugin
+//! reads them through the typed getters, which produce errors naming the key.
+
+use crate::{Error, Result};
+use std::collections::BTreeMap;
+
+/// One parameter value.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParamValue {
+    /// A number (integers are stored as numbers too).
+    Num(f64),
+    /// A string.
+    Str(String),
+    /// A flag.
+    Bool(bool),
+    /// A list of numbers (an axis, a rectangle, ...).
+    List(Vec<f64>),
+}
+
+/// An ordered map of named parameters.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Params(pub BTreeMap<String, ParamValue>);
+
+impl Params {
+    /// Empty parameters: every plugin falls back to its defaults.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Builder-style insertion.
+    pub fn with(mut self, key: &str, value: ParamValue) -> Self {
+        self.0.insert(key.to_string(), value);
+        self
+    }
+
+    /// Builder-style insertion of a number.
+    pub fn with_num(self, key: &str, value: f64) -> Self {
+        self.with(key, ParamValue::Num(value))
+    }
+
+    /// Parses `key=value`; the value is a number, `true`/`false`, a comma separated
+    /// list of numbers, or else a string.
+    pub fn parse_kv(text: &str) -> Result<(String, ParamValue)> {
+        let (k, v) = text
+            .split_once('=')
+            .ok_or_else(|| Error::param(text, "expected `key=value`"))?;
+        let (k, v) = (k.trim(), v.trim());
+        let value = if let Ok(x) = v.parse::<f64>() {
+            ParamValue::Num(x)
+        } else if v == "true" || v == "false" {
+            ParamValue::Bool(v == "true")
+        } else if v.contains(',') {
+            let list: std::result::Result<Vec<f64>, _> =
+                v.split(',').map(|s| s.trim().parse::<f64>()).collect();
+            match list {
+                Ok(l) => ParamValue::List(l),
+                Err(_) => ParamValue::Str(v.to_string()),
+            }
+        } else {
+            ParamValue::Str(v.to_string())
+        };
+        Ok((k.to_string(), value))
+    }
+
+    /// A number, or `default` when absent. Errors when present with another type or
+    /// not finite.
+    pub fn num_or(&self, key: &str, default: f64) -> Result<f64> {
+        match self.0.get(key) {
+            None => Ok(default),
+            Some(ParamValue::Num(x)) if x.is_finite() => Ok(*x),
+            Some(other) => Err(Error::param(
+                key,
+                format!("expected a finite number, got {other:?}"),
+            )),
+        }
+    }
+
+    /// A required number.
+    pub fn num(&self, key: &str) -> Result<f64> {
+        if !self.0.contains_key(key) {
+            return Err(Error::param(key, "required number is missing"));
+        }
+        self.num_or(key, f64::NAN)
+    }
+
+    /// A non-negative integer, or `default` when absent.
+    pub fn usize_or(&self, key: &str, default: usize) -> Result<usize> {
+        let x = self.num_or(key, default as f64)?;
+        if x < 0.0 || x.fract() != 0.0 {
+            return Err(Error::param(
+                key,
+                format!("expected a non-negative integer, got {x}"),
+            ));
+        }
+        Ok(x as usize)
+    }
+
+    /// A string, or `default` when absent.
+    pub fn str_or<'a>(&'a self, key: &str, default: &'a str) -> Result<&'a str> {
+        match self.0.get(key) {
+            None => Ok(default),
+            Some(ParamValue::Str(s)) => Ok(s),
+            Some(other) => Err(Error::param(
+                key,
+                format!("expected a string, got {other:?}"),
+            )),
+        }
+    }
+
+    /// A list of numbers, or `default` when absent.
+    pub fn list_or(&self, key: &str, default: &[f64]) -> Result<Vec<f64>> {
+        match self.0.get(key) {
+            None => Ok(default.to_vec()),
+            Some(ParamValue::List(l)) => Ok(l.clone()),
+            Some(other) => Err(Error::param(
+                key,
+                format!("expected a list of numbers, got {other:?}"),
+            )),
+        }
+    }
+
+    /// Errors on any key not in `known`: a typo must not silently fall back to a default.
+    pub fn reject_unknown(&self, plugin: &str, known: &[&str]) -> Result<()> {
+        for k in self.0.keys() {
+            if !known.contains(&k.as_str()) {
+                return Err(Error::param(
+                    k.clone(),
+                    format!(
+                        "unknown parameter for `{plugin}`; expected one of: {}",
+                        known.join(", ")
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parse_and_get() {
+        let (k, v) = Params::parse_kv("tol = 1e-6").unwrap();
+        assert_eq!(k, "tol");
+        assert_eq!(v, ParamValue::Num(1e-6));
+        let p = Params::new().with("tol", v).with_num("n", 3.0);
+        assert_eq!(p.num_or("tol", 1.0).unwrap(), 1e-6);
+        assert_eq!(p.usize_or("n", 1).unwrap(), 3);
+        assert!(p.usize_or("tol", 1).is_err());
+        assert_eq!(p.num_or("absent", 2.5).unwrap(), 2.5);
+        let (_, l) = Params::parse_kv("axis=0,0,1").unwrap();
+        assert_eq!(l, ParamValue::List(vec![0.0, 0.0, 1.0]));
+    }
+
+    #[test]
+    fn unknown_keys_are_rejected_with_their_name() {
+        let p = Params::new().with_num("tolerance", 1.0);
+        let e = p.reject_unknown("x", &["tol"]).unwrap_err().to_string();
+        assert!(e.contains("tolerance") && e.contains("tol"), "{e}");
+    }
+}

@@ -1,0 +1,19 @@
+//! # squeal
+//!
+//! Brake-squeal stability analysis: the facade crate. It re-exports the workspace crates
+//! and builds the default [`Registry`] with every built-in plugin. Adding a method is one
+//! crate under `plugins/` plus one `register` line in [`registry`].
+
+pub use squeal_analysis as analysis;
+pub use squeal_core as core;
+pub use squeal_core::Registry;
+pub use squeal_fe as fe;
+
+/// The registry with every built-in plugin.
+pub fn registry() -> Registry {
+    let mut reg = Registry::new();
+    squeal_materials::register(&mut reg);
+    squeal_eigen_arpack::register(&mut reg);
+    squeal_eigen_krylov::register(&mut reg);
+    reg
+}
