@@ -1,1 +1,2 @@
-//! (being written)
+//! Solid finite elements.
+pub mod hex8;
