@@ -8,6 +8,7 @@ pub use squeal_analysis as analysis;
 pub use squeal_core as core;
 pub use squeal_core::Registry;
 pub use squeal_fe as fe;
+pub use squeal_scene as scene;
 
 /// The registry with every built-in plugin.
 pub fn registry() -> Registry {

@@ -1,1 +1,136 @@
-fn main() {}
+//! The `squeal` command line.
+
+mod modes;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand, ValueEnum};
+use squeal_scene::Scene;
+
+/// Brake-squeal stability analysis.
+#[derive(Parser)]
+#[command(name = "squeal", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Bodies of a scene.
+#[derive(Clone, Copy, ValueEnum)]
+enum Body {
+    Disc,
+    Pin,
+    All,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Normal modes of the scene's bodies (free contact face), labelled.
+    Modes {
+        /// Scene file (TOML) or embedded scene name; default: the embedded `pin-on-disc`.
+        scene: Option<String>,
+        /// Which bodies.
+        #[arg(long, value_enum, default_value = "all")]
+        body: Body,
+        /// Band top (Hz).
+        #[arg(long, default_value_t = 10_500.0)]
+        max_freq: f64,
+        /// Eigen solver plugin.
+        #[arg(long, default_value = "arpack")]
+        eigen: String,
+        /// Relative tolerance of the eigen solver.
+        #[arg(long, default_value_t = 1e-12)]
+        tol: f64,
+        /// Write the modes as JSON here.
+        #[arg(long)]
+        json: Option<std::path::PathBuf>,
+    },
+    /// The main job: the uniform-contact validation on the embedded default scene
+    /// (for now: the disc's normal modes against Table 2 of the paper).
+    Validate {
+        /// Scene file or embedded name.
+        scene: Option<String>,
+        /// Eigen solver plugin.
+        #[arg(long, default_value = "arpack")]
+        eigen: String,
+        /// Write the report JSON here.
+        #[arg(long)]
+        json: Option<std::path::PathBuf>,
+    },
+    /// Lists the registered plugins.
+    Plugins,
+}
+
+/// Loads a scene: a file path, else an embedded name, else the default.
+pub fn load_scene(arg: Option<&str>) -> Result<(Scene, String)> {
+    match arg {
+        None => Ok((Scene::builtin("pin-on-disc")?, "<builtin pin-on-disc>".into())),
+        Some(a) if std::path::Path::new(a).exists() => {
+            Ok((Scene::from_file(std::path::Path::new(a))?, a.to_string()))
+        }
+        Some(a) if !a.ends_with(".toml") => Ok((Scene::builtin(a)?, format!("<builtin {a}>"))),
+        Some(a) => Err(anyhow::anyhow!("{a}: no such scene file")),
+    }
+}
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run() -> Result<()> {
+    let cli = Cli::parse();
+    let registry = squeal::registry();
+    match cli.command {
+        Command::Modes { scene, body, max_freq, eigen, tol, json } => {
+            let which = match body {
+                Body::Disc => squeal_scene::BodyKind::Disc,
+                Body::Pin => squeal_scene::BodyKind::Pin,
+                Body::All => squeal_scene::BodyKind::All,
+            };
+            let report = modes::run(&registry, scene.as_deref(), which, max_freq, &eigen, tol)?;
+            print!("{}", modes::format(&report));
+            if let Some(path) = json {
+                modes::write_json(&report, &path)?;
+            }
+        }
+        Command::Validate { scene, eigen, json } => {
+            let report = modes::run(&registry, scene.as_deref(), squeal_scene::BodyKind::Disc, 10_500.0, &eigen, 1e-12)?;
+            let rows = squeal_analysis::modal::compare_table2(&report.modes);
+            println!("Disc normal modes (free friction face): paper Table 2 vs squeal");
+            println!(
+                "model: {} DOFs, {} elements, solved by `{}` in {:.2} s (build {:.2} s)\n",
+                report.dofs, report.elements, report.solver, report.solve_time_s, report.build_time_s
+            );
+            print!("{}", squeal_analysis::modal::format_table(&rows));
+            let within = |t: f64| rows.iter().filter(|r| r.rel_err.is_some_and(|e| e.abs() <= t)).count();
+            println!(
+                "\n{} of {} labels found; {} within 5 %, {} within 10 %",
+                rows.iter().filter(|r| r.squeal_hz.is_some()).count(),
+                rows.len(),
+                within(0.05),
+                within(0.10)
+            );
+            if let Some(path) = json {
+                let v = serde_json::json!({ "units": "SI (Hz)", "table2": rows, "modes": report.modes });
+                std::fs::write(&path, serde_json::to_string_pretty(&v)?)
+                    .with_context(|| format!("writing {}", path.display()))?;
+            }
+        }
+        Command::Plugins => {
+            for (kind, list) in [
+                ("material", registry.materials.describe()),
+                ("contact law", registry.contact_laws.describe()),
+                ("equilibrium", registry.equilibrium.describe()),
+                ("basis", registry.bases.describe()),
+                ("eigen", registry.eigen.describe()),
+            ] {
+                for (name, desc) in list {
+                    println!("{kind:<12} {name:<24} {desc}");
+                }
+            }
+        }
+    }
+    Ok(())
+}

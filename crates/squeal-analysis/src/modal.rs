@@ -1,0 +1,156 @@
+//! Normal-mode analysis of a built model: solve, attribute each mode to a body, label
+//! it, pair doublets, and compare the disc with the paper's Table 2.
+
+use crate::labels::{body_shares, label_disc, label_pin, nodal_weights};
+use crate::reference::TABLE2;
+use serde::Serialize;
+use squeal_core::{EigenParams, EigenSolver, RealModes, Result, SymmetricProblem};
+use squeal_scene::Model;
+
+/// One labelled mode (the `modes` entries of `squeal modes --json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct ModeRecord {
+    /// `disc` or `pin` (the pin with its plates).
+    pub body: String,
+    /// Index in the frequency-sorted list of the solve, from 1.
+    pub index: usize,
+    /// Frequency (Hz).
+    pub freq_hz: f64,
+    /// Label (`a,0,3`, `c,1`, `r,2` for the disc; `tilt-y` ... for the pin).
+    pub label: String,
+    /// Relative residual of the eigenpair.
+    pub residual: f64,
+    /// Index of the other member of a doublet.
+    pub partner: Option<usize>,
+}
+
+/// Doublet members must lie within this relative frequency distance.
+pub const DOUBLET_TOL: f64 = 0.02;
+
+/// Solves the normal modes of `model` and labels them.
+pub fn normal_modes(
+    model: &Model,
+    solver: &dyn EigenSolver,
+    params: &EigenParams,
+) -> Result<(RealModes, Vec<ModeRecord>)> {
+    let problem = SymmetricProblem {
+        k: model.k.as_ref(),
+        m: model.m.as_ref(),
+    };
+    let modes = solver.solve_symmetric(&problem, params)?;
+    let records = label_modes(model, &modes);
+    Ok((modes, records))
+}
+
+/// Attributes, labels and pairs the modes of `model`.
+pub fn label_modes(model: &Model, modes: &RealModes) -> Vec<ModeRecord> {
+    let mesh = &model.mesh;
+    let weights = nodal_weights(mesh);
+    let body_of = |name: &str| model.body_names.iter().position(|b| b == name);
+    let disc_nodes = body_of("disc").map(|b| mesh.body_nodes(b)).unwrap_or_default();
+    let pin_nodes = body_of("pin").map(|b| mesh.body_nodes(b)).unwrap_or_default();
+    let mut out: Vec<ModeRecord> = (0..modes.freq_hz.len())
+        .map(|i| {
+            let free: Vec<f64> = (0..modes.vectors.nrows()).map(|r| modes.vectors[(r, i)]).collect();
+            let u = model.dofs.expand(&free);
+            let shares = body_shares(mesh, &weights, &u, model.body_names.len());
+            let disc_share = body_of("disc").map(|b| shares[b]).unwrap_or(0.0);
+            let (body, label) = if disc_share >= 0.5 {
+                ("disc", label_disc(mesh, &weights, &disc_nodes, &u).to_string())
+            } else {
+                ("pin", label_pin(mesh, &pin_nodes, &u))
+            };
+            ModeRecord {
+                body: body.into(),
+                index: i + 1,
+                freq_hz: modes.freq_hz[i],
+                label,
+                residual: modes.residuals[i],
+                partner: None,
+            }
+        })
+        .collect();
+    pair_doublets(&mut out);
+    out
+}
+
+/// Pairs disc modes of equal label with `n > 0` whose frequencies differ by less than
+/// [`DOUBLET_TOL`]: nearest unpaired partner first.
+pub fn pair_doublets(modes: &mut [ModeRecord]) {
+    for i in 0..modes.len() {
+        if modes[i].partner.is_some() || modes[i].body != "disc" || modes[i].label.ends_with(",0") {
+            continue;
+        }
+        let best = (0..modes.len())
+            .filter(|&j| j != i && modes[j].partner.is_none() && modes[j].body == "disc")
+            .filter(|&j| modes[j].label == modes[i].label)
+            .map(|j| (j, (modes[j].freq_hz / modes[i].freq_hz - 1.0).abs()))
+            .filter(|&(_, d)| d < DOUBLET_TOL)
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((j, _)) = best {
+            modes[i].partner = Some(modes[j].index);
+            modes[j].partner = Some(modes[i].index);
+        }
+    }
+}
+
+/// One row of the comparison with the paper's Table 2.
+#[derive(Debug, Clone, Serialize)]
+pub struct TableRow {
+    /// Label.
+    pub label: String,
+    /// The paper's FE frequency (Hz).
+    pub paper_hz: f64,
+    /// Whether the paper lists a doublet.
+    pub paper_double: bool,
+    /// squeal's frequency (Hz): the mean of a doublet, `None` if no mode has the label.
+    pub squeal_hz: Option<f64>,
+    /// Relative error `(squeal - paper) / paper`.
+    pub rel_err: Option<f64>,
+    /// Relative split of the doublet `(f2 - f1) / f1`, when paired.
+    pub doublet_split: Option<f64>,
+}
+
+/// Compares labelled disc modes with Table 2 of the paper.
+pub fn compare_table2(modes: &[ModeRecord]) -> Vec<TableRow> {
+    TABLE2
+        .iter()
+        .map(|&(label, paper_hz, paper_double)| {
+            let first = modes.iter().find(|m| m.body == "disc" && m.label == label);
+            let (squeal_hz, split) = match first {
+                None => (None, None),
+                Some(m) => match m.partner.and_then(|p| modes.iter().find(|x| x.index == p)) {
+                    Some(p) => (
+                        Some(0.5 * (m.freq_hz + p.freq_hz)),
+                        Some((p.freq_hz - m.freq_hz).abs() / m.freq_hz.min(p.freq_hz)),
+                    ),
+                    None => (Some(m.freq_hz), None),
+                },
+            };
+            TableRow {
+                label: label.into(),
+                paper_hz,
+                paper_double,
+                squeal_hz,
+                rel_err: squeal_hz.map(|f| (f - paper_hz) / paper_hz),
+                doublet_split: split,
+            }
+        })
+        .collect()
+}
+
+/// Plain-text table of [`compare_table2`] rows.
+pub fn format_table(rows: &[TableRow]) -> String {
+    let mut s = String::from("label    paper (Hz)  squeal (Hz)   error   doublet split\n");
+    for r in rows {
+        let f = r.squeal_hz.map_or("missing".into(), |v| format!("{v:.1}"));
+        let e = r.rel_err.map_or("-".into(), |v| format!("{:+.2} %", 100.0 * v));
+        let d = match (r.paper_double, r.doublet_split) {
+            (true, Some(x)) => format!("{:.3} %", 100.0 * x),
+            (true, None) => "unpaired".into(),
+            (false, _) => "single".into(),
+        };
+        s.push_str(&format!("{:<8} {:>10.1} {:>12} {:>9}   {}\n", r.label, r.paper_hz, f, e, d));
+    }
+    s
+}

@@ -1,0 +1,89 @@
+//! `squeal modes`: build, solve, label, print and write JSON.
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+use squeal_analysis::modal::{normal_modes, ModeRecord};
+use squeal_core::{EigenParams, Params, Registry};
+use squeal_scene::{build, BodyKind};
+use std::time::Instant;
+
+/// What `squeal modes --json` writes.
+#[derive(Serialize)]
+pub struct ModesReport {
+    pub scene: String,
+    pub units: &'static str,
+    pub dofs: usize,
+    pub elements: usize,
+    pub total_mass_kg: f64,
+    pub solver: String,
+    pub tol: f64,
+    pub max_freq_hz: f64,
+    pub build_time_s: f64,
+    pub solve_time_s: f64,
+    pub time_s: f64,
+    pub notes: Vec<String>,
+    pub modes: Vec<ModeRecord>,
+}
+
+pub fn run(
+    registry: &Registry,
+    scene: Option<&str>,
+    which: BodyKind,
+    max_freq: f64,
+    eigen: &str,
+    tol: f64,
+) -> Result<ModesReport> {
+    let start = Instant::now();
+    let (scene, file) = crate::load_scene(scene)?;
+    let model = build(&scene, which, registry, &file)?;
+    let solver = registry.eigen.create(eigen, &Params::new())?;
+    let params = EigenParams {
+        fmax_hz: max_freq,
+        tol,
+        ..EigenParams::default()
+    };
+    let (modes, records) = normal_modes(&model, solver.as_ref(), &params)
+        .with_context(|| format!("normal modes of {file} with `{eigen}`"))?;
+    Ok(ModesReport {
+        scene: file,
+        units: "SI: frequencies in Hz, masses in kg, times in s",
+        dofs: model.dofs.n_free(),
+        elements: model.mesh.hexes.len(),
+        total_mass_kg: model.total_mass,
+        solver: eigen.into(),
+        tol,
+        max_freq_hz: max_freq,
+        build_time_s: model.build_time_s,
+        solve_time_s: modes.info.time_s,
+        time_s: start.elapsed().as_secs_f64(),
+        notes: modes.info.notes.clone(),
+        modes: records,
+    })
+}
+
+pub fn format(r: &ModesReport) -> String {
+    let mut s = format!(
+        "{}: {} DOFs, {} elements, {:.3} kg; `{}` in {:.2} s\n  #  body   freq (Hz)   label     residual  doublet\n",
+        r.scene, r.dofs, r.elements, r.total_mass_kg, r.solver, r.solve_time_s
+    );
+    for m in &r.modes {
+        s.push_str(&format!(
+            "{:>3}  {:<5} {:>10.1}   {:<8} {:>9.1e}  {}\n",
+            m.index,
+            m.body,
+            m.freq_hz,
+            m.label,
+            m.residual,
+            m.partner.map_or(String::new(), |p| format!("with #{p}"))
+        ));
+    }
+    for n in &r.notes {
+        s.push_str(&format!("note: {n}\n"));
+    }
+    s
+}
+
+pub fn write_json(r: &ModesReport, path: &std::path::Path) -> Result<()> {
+    let text = serde_json::to_string_pretty(r)?;
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}

@@ -1,0 +1,273 @@
+//! The scene file format (serde). Every length in metres, modulus in Pa, density in
+//! kg/m^3, frequency in Hz; field names carry their unit.
+
+use crate::{Result, SceneError};
+use serde::{Deserialize, Serialize};
+use squeal_core::{ParamValue, Params};
+use std::collections::BTreeMap;
+
+/// The embedded default scene, the paper's pin-on-disc rig.
+pub const PIN_ON_DISC: &str = include_str!("../../../scenes/pin-on-disc.toml");
+
+/// A material: plugin name plus its constants.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MaterialSpec {
+    /// Material plugin name (`isotropic`, `transversely_isotropic`, ...).
+    pub kind: String,
+    /// Constants passed to the plugin (names with units, e.g. `youngs_modulus_pa`).
+    #[serde(flatten)]
+    pub constants: BTreeMap<String, toml::Value>,
+}
+
+impl MaterialSpec {
+    /// Converts the constants to plugin [`Params`]; `field` names the table for errors.
+    pub fn params(&self, file: &str, field: &str) -> Result<Params> {
+        let mut p = Params::new();
+        for (k, v) in &self.constants {
+            let value = match v {
+                toml::Value::Float(x) => ParamValue::Num(*x),
+                toml::Value::Integer(i) => ParamValue::Num(*i as f64),
+                toml::Value::Boolean(b) => ParamValue::Bool(*b),
+                toml::Value::String(s) => ParamValue::Str(s.clone()),
+                toml::Value::Array(a) => ParamValue::List(
+                    a.iter()
+                        .map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
+                        .collect::<Option<Vec<f64>>>()
+                        .ok_or_else(|| SceneError::Field {
+                            file: file.into(),
+                            field: format!("{field}.{k}"),
+                            message: "expected a list of numbers".into(),
+                        })?,
+                ),
+                other => {
+                    return Err(SceneError::Field {
+                        file: file.into(),
+                        field: format!("{field}.{k}"),
+                        message: format!("expected a number, string or list, got {other}"),
+                    })
+                }
+            };
+            p.0.insert(k.clone(), value);
+        }
+        Ok(p)
+    }
+}
+
+/// An annular disc about the z axis, clamped on its inner (hub) cylinder, its top face
+/// (z = 0) the friction face.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Disc {
+    /// Radius of the clamped hub face (m).
+    pub inner_radius_m: f64,
+    /// Outer radius (m).
+    pub outer_radius_m: f64,
+    /// Thickness (m); the disc spans z in [-thickness, 0].
+    pub thickness_m: f64,
+    /// Material.
+    pub material: MaterialSpec,
+}
+
+/// The pin: a rectangular block standing on the disc's friction face.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pin {
+    /// Radius of the pin face centre (the mean friction radius) (m).
+    pub center_radius_m: f64,
+    /// Face size along the sliding direction x (m).
+    pub size_x_m: f64,
+    /// Face size along the radius y (m).
+    pub size_y_m: f64,
+    /// Height (m).
+    pub height_m: f64,
+    /// Material (the pad's, transversely isotropic about z).
+    pub material: MaterialSpec,
+}
+
+/// A rectangular plate centred over the pin.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Plate {
+    /// Length along x (m); the thin plate is fixed at both x ends.
+    pub length_x_m: f64,
+    /// Width along y (m).
+    pub width_y_m: f64,
+    /// Thickness (m).
+    pub thickness_m: f64,
+    /// Material.
+    pub material: MaterialSpec,
+}
+
+/// How element sizes follow from the frequency band.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MeshRule {
+    /// Highest frequency the model must resolve (Hz).
+    pub max_freq_hz: f64,
+    /// Elements per bending wavelength at `max_freq_hz`.
+    pub elements_per_wavelength: f64,
+    /// Minimum element layers through any thickness.
+    pub min_layers: usize,
+    /// Elements along each side of the pin face.
+    pub pin_face_elements: usize,
+}
+
+impl Default for MeshRule {
+    fn default() -> Self {
+        Self {
+            max_freq_hz: 10_500.0,
+            elements_per_wavelength: 12.0,
+            min_layers: 2,
+            pin_face_elements: 10,
+        }
+    }
+}
+
+/// A scene: the bodies present, their materials and the mesh rule.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Scene name.
+    pub name: String,
+    /// Free text.
+    #[serde(default)]
+    pub description: String,
+    /// The disc, if present.
+    pub disc: Option<Disc>,
+    /// The pin, if present.
+    pub pin: Option<Pin>,
+    /// The thin plate the pin is glued on, fixed at its x ends.
+    pub thin_plate: Option<Plate>,
+    /// The thick plate on the thin plate, over the pin.
+    pub thick_plate: Option<Plate>,
+    /// Mesh rule.
+    #[serde(default)]
+    pub mesh: MeshRule,
+}
+
+impl Scene {
+    /// Parses a scene from TOML text; `file` names it in errors.
+    pub fn from_toml(text: &str, file: &str) -> Result<Scene> {
+        let scene: Scene = toml::from_str(text).map_err(|e| SceneError::Parse {
+            file: file.into(),
+            message: e.to_string(),
+        })?;
+        scene.validate(file)?;
+        Ok(scene)
+    }
+
+    /// Reads a scene file.
+    pub fn from_file(path: &std::path::Path) -> Result<Scene> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            file: file.clone(),
+            source,
+        })?;
+        Self::from_toml(&text, &file)
+    }
+
+    /// An embedded scene by name (`pin-on-disc`).
+    pub fn builtin(name: &str) -> Result<Scene> {
+        match name {
+            "pin-on-disc" => Self::from_toml(PIN_ON_DISC, "<builtin pin-on-disc>"),
+            other => Err(SceneError::Field {
+                file: format!("<builtin {other}>"),
+                field: "name".into(),
+                message: "no such embedded scene; available: pin-on-disc".into(),
+            }),
+        }
+    }
+
+    /// Writes the scene back as TOML.
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).expect("scene serializes")
+    }
+
+    /// Checks every dimension; errors name the field and the expected range.
+    pub fn validate(&self, file: &str) -> Result<()> {
+        let field = |f: &str, m: String| SceneError::Field {
+            file: file.into(),
+            field: f.into(),
+            message: m,
+        };
+        let positive = |f: &str, v: f64| -> Result<()> {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(field(f, format!("expected a positive length in metres, got {v}")))
+            }
+        };
+        if let Some(d) = &self.disc {
+            positive("disc.inner_radius_m", d.inner_radius_m)?;
+            positive("disc.outer_radius_m", d.outer_radius_m)?;
+            positive("disc.thickness_m", d.thickness_m)?;
+            if d.inner_radius_m >= d.outer_radius_m {
+                return Err(field(
+                    "disc.inner_radius_m",
+                    format!(
+                        "expected less than disc.outer_radius_m = {}, got {}",
+                        d.outer_radius_m, d.inner_radius_m
+                    ),
+                ));
+            }
+        }
+        if let Some(p) = &self.pin {
+            positive("pin.center_radius_m", p.center_radius_m)?;
+            positive("pin.size_x_m", p.size_x_m)?;
+            positive("pin.size_y_m", p.size_y_m)?;
+            positive("pin.height_m", p.height_m)?;
+            if let Some(d) = &self.disc {
+                let (r0, r1) = (p.center_radius_m - p.size_y_m / 2.0, p.center_radius_m + p.size_y_m / 2.0);
+                let rmax = (r1 * r1 + p.size_x_m * p.size_x_m / 4.0).sqrt();
+                if r0 <= d.inner_radius_m || rmax >= d.outer_radius_m {
+                    return Err(field(
+                        "pin.center_radius_m",
+                        format!(
+                            "the pin face (radii {r0:.4} to {rmax:.4} m) must lie on the disc face \
+                             between disc.inner_radius_m = {} and disc.outer_radius_m = {}",
+                            d.inner_radius_m, d.outer_radius_m
+                        ),
+                    ));
+                }
+            }
+        }
+        for (name, plate) in [("thin_plate", &self.thin_plate), ("thick_plate", &self.thick_plate)] {
+            if let Some(pl) = plate {
+                positive(&format!("{name}.length_x_m"), pl.length_x_m)?;
+                positive(&format!("{name}.width_y_m"), pl.width_y_m)?;
+                positive(&format!("{name}.thickness_m"), pl.thickness_m)?;
+                if let Some(p) = &self.pin {
+                    if pl.length_x_m < p.size_x_m || pl.width_y_m < p.size_y_m {
+                        return Err(field(
+                            &format!("{name}.length_x_m"),
+                            format!(
+                                "the plate ({} x {} m) must cover the pin face ({} x {} m)",
+                                pl.length_x_m, pl.width_y_m, p.size_x_m, p.size_y_m
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        if (self.thin_plate.is_some() || self.thick_plate.is_some()) && self.pin.is_none() {
+            return Err(field("pin", "plates are placed over the pin: a [pin] table is required".into()));
+        }
+        if self.thick_plate.is_some() && self.thin_plate.is_none() {
+            return Err(field("thin_plate", "the thick plate sits on the thin plate: a [thin_plate] table is required".into()));
+        }
+        let m = &self.mesh;
+        if !(m.max_freq_hz.is_finite() && m.max_freq_hz > 0.0) {
+            return Err(field("mesh.max_freq_hz", format!("expected a positive frequency in Hz, got {}", m.max_freq_hz)));
+        }
+        if !(m.elements_per_wavelength.is_finite() && m.elements_per_wavelength >= 2.0) {
+            return Err(field("mesh.elements_per_wavelength", format!("expected a number >= 2, got {}", m.elements_per_wavelength)));
+        }
+        if m.min_layers == 0 || m.pin_face_elements == 0 {
+            return Err(field("mesh.min_layers", "expected at least 1 layer and 1 pin face element".into()));
+        }
+        if self.disc.is_none() && self.pin.is_none() {
+            return Err(field("disc", "a scene needs at least a [disc] or a [pin]".into()));
+        }
+        Ok(())
+    }
+}

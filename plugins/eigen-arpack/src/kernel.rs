@@ -1,0 +1,237 @@
+//! [`ArpackKernel`]: `dsaupd`/`dseupd` in mode 3 driven by reverse communication.
+
+use crate::error::{ArpackError, Routine};
+use arpack_ffi::{a_int, dsaupd_c, dseupd_c, ARPACK_LOCK};
+use core::ffi::c_char;
+use squeal_core::eigen::{KernelOutput, SymmetricKernel};
+use squeal_core::faer::Mat;
+use squeal_core::linalg::ShiftInvert;
+use squeal_core::Result;
+
+/// ARPACK's symmetric driver in shift-invert mode 3 (`bmat = 'G'`, `which = "LM"`) on
+/// the operator `OP = (K - sigma M)^-1 M` of a [`ShiftInvert`].
+///
+/// Lanczos basis size `ncv = min(n, max(2 nev + 1, nev + 20))`; exact shifts
+/// (`iparam[0] = 1`); a fixed start vector `1 + 0.1 sin(i)` (`info = 1` on entry), so
+/// that runs are reproducible. The iteration cap (`info = 1`) is not an error: the
+/// pairs that converged are returned with `all_converged = false`.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ArpackKernel;
+
+/// `a_int` from `usize`, or [`ArpackError::TooLarge`].
+fn to_int(what: &'static str, value: usize) -> Result<a_int, ArpackError> {
+    a_int::try_from(value).map_err(|_| ArpackError::TooLarge { what, value })
+}
+
+/// The input `x = workd[ipntr[src]-1..][..n]` and output `y = workd[ipntr[dst]-1..][..n]`
+/// of a reverse-communication request (ARPACK's pointers are 1-based Fortran indices).
+fn request_io<'w>(
+    workd: &'w mut [f64],
+    ipntr: &[a_int],
+    src: usize,
+    dst: usize,
+    ido: a_int,
+    n: usize,
+) -> Result<(&'w [f64], &'w mut [f64]), ArpackError> {
+    let bad = || ArpackError::BadPointers {
+        ido,
+        ipntr: [ipntr[0], ipntr[1], ipntr[2]],
+        n,
+    };
+    let offset = |p: a_int| -> Result<usize, ArpackError> {
+        let p = usize::try_from(p).map_err(|_| bad())?;
+        match p.checked_sub(1) {
+            Some(o) if o + n <= workd.len() => Ok(o),
+            _ => Err(bad()),
+        }
+    };
+    let (s, d) = (offset(ipntr[src])?, offset(ipntr[dst])?);
+    if s + n <= d {
+        let (a, b) = workd.split_at_mut(d);
+        Ok((&a[s..s + n], &mut b[..n]))
+    } else if d + n <= s {
+        let (a, b) = workd.split_at_mut(s);
+        Ok((&b[..n], &mut a[d..d + n]))
+    } else {
+        Err(bad())
+    }
+}
+
+impl SymmetricKernel for ArpackKernel {
+    fn largest(
+        &self,
+        op: &ShiftInvert<'_>,
+        nev: usize,
+        tol: f64,
+        max_restarts: usize,
+    ) -> Result<KernelOutput> {
+        Ok(run(op, nev, tol, max_restarts)?)
+    }
+}
+
+fn run(
+    op: &ShiftInvert<'_>,
+    nev: usize,
+    tol: f64,
+    max_restarts: usize,
+) -> Result<KernelOutput, ArpackError> {
+    let n = op.dim();
+    if nev == 0 || nev >= n {
+        return Err(ArpackError::BadRequest { nev, n });
+    }
+    let ncv = n.min((2 * nev + 1).max(nev + 20));
+    let lworkl = ncv * (ncv + 8);
+    let n_c = to_int("n", n)?;
+    let nev_c = to_int("nev", nev)?;
+    let ncv_c = to_int("ncv", ncv)?;
+    let lworkl_c = to_int("lworkl = ncv (ncv + 8)", lworkl)?;
+    // Buffers whose Fortran length is a product of sizes must not overflow either.
+    to_int("n ncv", n.checked_mul(ncv).unwrap_or(usize::MAX))?;
+    to_int("3 n", n.checked_mul(3).unwrap_or(usize::MAX))?;
+    let maxiter = a_int::try_from(max_restarts).unwrap_or(a_int::MAX);
+
+    let bmat = b"G\0".as_ptr().cast::<c_char>();
+    let which = b"LM\0".as_ptr().cast::<c_char>();
+    let mut ido: a_int = 0;
+    let mut info: a_int = 1; // use `resid` as the start vector
+    let mut resid: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
+    let mut v = vec![0.0; n * ncv];
+    let mut iparam = [0 as a_int; 11];
+    let mut ipntr = [0 as a_int; 11];
+    let mut workd = vec![0.0; 3 * n];
+    let mut workl = vec![0.0; lworkl];
+    iparam[0] = 1; // exact shifts
+    iparam[2] = maxiter;
+    iparam[3] = 1; // block size (must be 1)
+    iparam[6] = 3; // shift-invert, generalized
+
+    // ARPACK keeps its state in Fortran SAVE variables: one run at a time per process.
+    let _guard = ARPACK_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    loop {
+        // SAFETY: `resid` has n entries, `v` n * ncv (ldv = n), `iparam` and `ipntr` 11,
+        // `workd` 3 n, `workl` lworkl = ncv (ncv + 8); the strings hold 1 and 2
+        // characters; ARPACK is serialized by ARPACK_LOCK.
+        unsafe {
+            dsaupd_c(
+                &mut ido,
+                bmat,
+                n_c,
+                which,
+                nev_c,
+                tol,
+                resid.as_mut_ptr(),
+                ncv_c,
+                v.as_mut_ptr(),
+                n_c,
+                iparam.as_mut_ptr(),
+                ipntr.as_mut_ptr(),
+                workd.as_mut_ptr(),
+                workl.as_mut_ptr(),
+                lworkl_c,
+                &mut info,
+            );
+        }
+        match ido {
+            // y = OP x = (K - sigma M)^-1 M x, B x not available (initialization).
+            -1 => {
+                let (x, y) = request_io(&mut workd, &ipntr, 0, 1, ido, n)?;
+                op.apply(x, y);
+            }
+            // y = OP x with B x = M x already at workd[ipntr[2]-1..].
+            1 => {
+                let (mx, y) = request_io(&mut workd, &ipntr, 2, 1, ido, n)?;
+                op.apply_with_mx(mx, y);
+            }
+            // y = B x = M x.
+            2 => {
+                let (x, y) = request_io(&mut workd, &ipntr, 0, 1, ido, n)?;
+                op.m_mul(x, y);
+            }
+            99 => break,
+            other => {
+                // An error exit also ends with ido = 99; anything else is a protocol
+                // violation unless info already says what went wrong.
+                if info < 0 {
+                    break;
+                }
+                return Err(ArpackError::UnexpectedRequest { ido: other });
+            }
+        }
+    }
+    let iterations = usize::try_from(iparam[2]).unwrap_or(0);
+    match info {
+        0 | 1 => {}
+        code => {
+            return Err(ArpackError::from_info(
+                Routine::Dsaupd,
+                code,
+                nev,
+                ncv,
+                iparam[4],
+            ))
+        }
+    }
+    let nconv = usize::try_from(iparam[4]).unwrap_or(0).min(nev);
+    if nconv == 0 {
+        // Only possible with info = 1: nothing to extract (dseupd would say -14).
+        return Ok(KernelOutput {
+            theta: Vec::new(),
+            vectors: Mat::zeros(n, 0),
+            iterations,
+            all_converged: false,
+        });
+    }
+
+    let sigma = op.sigma();
+    let select = vec![0 as a_int; ncv];
+    let mut d = vec![0.0; nev];
+    let mut z = vec![0.0; n * nev];
+    let mut info_e: a_int = 0;
+    // SAFETY: as above, plus `select` (ncv entries, workspace for howmny = 'A'), `d`
+    // (nev) and `z` (n * nev, ldz = n); the dsaupd state is passed back unchanged.
+    unsafe {
+        dseupd_c(
+            1,
+            b"A\0".as_ptr().cast::<c_char>(),
+            select.as_ptr(),
+            d.as_mut_ptr(),
+            z.as_mut_ptr(),
+            n_c,
+            sigma,
+            bmat,
+            n_c,
+            which,
+            nev_c,
+            tol,
+            resid.as_mut_ptr(),
+            ncv_c,
+            v.as_mut_ptr(),
+            n_c,
+            iparam.as_mut_ptr(),
+            ipntr.as_mut_ptr(),
+            workd.as_mut_ptr(),
+            workl.as_mut_ptr(),
+            lworkl_c,
+            &mut info_e,
+        );
+    }
+    drop(_guard);
+    if info_e != 0 {
+        return Err(ArpackError::from_info(
+            Routine::Dseupd,
+            info_e,
+            nev,
+            ncv,
+            iparam[4],
+        ));
+    }
+    // dseupd back-transformed to lambda = sigma + 1 / theta; the kernel contract is theta.
+    let theta: Vec<f64> = d[..nconv].iter().map(|&l| 1.0 / (l - sigma)).collect();
+    let vectors = Mat::from_fn(n, nconv, |i, j| z[j * n + i]);
+    Ok(KernelOutput {
+        theta,
+        vectors,
+        iterations,
+        all_converged: nconv == nev,
+    })
+}
