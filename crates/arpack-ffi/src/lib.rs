@@ -12,8 +12,8 @@
 //!   Scalars that Fortran only reads (`n`, `nev`, `ncv`, `ldv`, `lworkl`, `tol`,
 //!   `rvec`, `sigma`) are passed **by value**; `ido`, `info`, `iparam`, `ipntr` by pointer.
 //! - `bmat` and `howmny` are one character, `which` is **two** characters; none needs a
-//!   NUL terminator (the Fortran side reads a fixed length), but passing `b"G\0"` or
-//!   `b"LM\0"` is harmless.
+//!   NUL terminator (the Fortran side reads a fixed length), but passing C string
+//!   literals such as `c"G".as_ptr()` or `c"LM".as_ptr()` is harmless and convenient.
 //! - `rvec` and `select` are integer stand-ins for Fortran `LOGICAL`: nonzero is true.
 //!   `select` must hold `ncv` entries even with `howmny = 'A'` (then it is workspace).
 //! - `ipntr` entries are **1-based Fortran indices** into `workd`: the vector `x` of a
@@ -266,8 +266,8 @@ mod tests {
         iparam[0] = 1;
         iparam[2] = 300;
         iparam[6] = 1;
-        let bmat = b"I\0".as_ptr().cast::<c_char>();
-        let which = b"LM\0".as_ptr().cast::<c_char>();
+        let bmat = c"I".as_ptr();
+        let which = c"LM".as_ptr();
         loop {
             // SAFETY: all buffers have the sizes documented for dsaupd_c.
             unsafe {
@@ -308,7 +308,7 @@ mod tests {
         unsafe {
             dseupd_c(
                 1,
-                b"A\0".as_ptr().cast(),
+                c"A".as_ptr(),
                 select.as_ptr(),
                 d.as_mut_ptr(),
                 z.as_mut_ptr(),
@@ -369,8 +369,8 @@ mod tests {
         iparam[0] = 1;
         iparam[2] = 300;
         iparam[6] = 3;
-        let bmat = b"I\0".as_ptr().cast::<c_char>();
-        let which = b"LM\0".as_ptr().cast::<c_char>();
+        let bmat = c"I".as_ptr();
+        let which = c"LM".as_ptr();
         loop {
             // SAFETY: all buffers have the sizes documented for znaupd_c.
             unsafe {
@@ -420,7 +420,7 @@ mod tests {
         unsafe {
             zneupd_c(
                 1,
-                b"A\0".as_ptr().cast(),
+                c"A".as_ptr(),
                 select.as_ptr(),
                 d.as_mut_ptr(),
                 z.as_mut_ptr(),
@@ -476,8 +476,8 @@ mod tests {
         iparam[0] = 1;
         iparam[2] = 300;
         iparam[6] = 1;
-        let bmat = b"I\0".as_ptr().cast::<c_char>();
-        let which = b"LM\0".as_ptr().cast::<c_char>();
+        let bmat = c"I".as_ptr();
+        let which = c"LM".as_ptr();
         loop {
             // SAFETY: all buffers have the sizes documented for dnaupd_c.
             unsafe {
@@ -521,7 +521,7 @@ mod tests {
         unsafe {
             dneupd_c(
                 1,
-                b"A\0".as_ptr().cast(),
+                c"A".as_ptr(),
                 select.as_ptr(),
                 dr.as_mut_ptr(),
                 di.as_mut_ptr(),

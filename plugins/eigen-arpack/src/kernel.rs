@@ -2,7 +2,6 @@
 
 use crate::error::{ArpackError, Routine};
 use arpack_ffi::{a_int, dsaupd_c, dseupd_c, ARPACK_LOCK};
-use core::ffi::c_char;
 use squeal_core::eigen::{KernelOutput, SymmetricKernel};
 use squeal_core::faer::Mat;
 use squeal_core::linalg::ShiftInvert;
@@ -14,7 +13,9 @@ use squeal_core::Result;
 /// Lanczos basis size `ncv = min(n, max(2 nev + 1, nev + 20))`; exact shifts
 /// (`iparam[0] = 1`); a fixed start vector `1 + 0.1 sin(i)` (`info = 1` on entry), so
 /// that runs are reproducible. The iteration cap (`info = 1`) is not an error: the
-/// pairs that converged are returned with `all_converged = false`.
+/// pairs that converged are returned with `all_converged = false`. `iterations` is
+/// ARPACK's `iparam[2]` on return, which counts the initial factorization too (it can
+/// exceed `max_restarts` by one).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ArpackKernel;
 
@@ -86,12 +87,12 @@ fn run(
     let ncv_c = to_int("ncv", ncv)?;
     let lworkl_c = to_int("lworkl = ncv (ncv + 8)", lworkl)?;
     // Buffers whose Fortran length is a product of sizes must not overflow either.
-    to_int("n ncv", n.checked_mul(ncv).unwrap_or(usize::MAX))?;
-    to_int("3 n", n.checked_mul(3).unwrap_or(usize::MAX))?;
+    to_int("n ncv", n.saturating_mul(ncv))?;
+    to_int("3 n", n.saturating_mul(3))?;
     let maxiter = a_int::try_from(max_restarts).unwrap_or(a_int::MAX);
 
-    let bmat = b"G\0".as_ptr().cast::<c_char>();
-    let which = b"LM\0".as_ptr().cast::<c_char>();
+    let bmat = c"G".as_ptr();
+    let which = c"LM".as_ptr();
     let mut ido: a_int = 0;
     let mut info: a_int = 1; // use `resid` as the start vector
     let mut resid: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
@@ -106,7 +107,7 @@ fn run(
     iparam[6] = 3; // shift-invert, generalized
 
     // ARPACK keeps its state in Fortran SAVE variables: one run at a time per process.
-    let _guard = ARPACK_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    let guard = ARPACK_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     loop {
         // SAFETY: `resid` has n entries, `v` n * ncv (ldv = n), `iparam` and `ipntr` 11,
         // `workd` 3 n, `workl` lworkl = ncv (ncv + 8); the strings hold 1 and 2
@@ -192,7 +193,7 @@ fn run(
     unsafe {
         dseupd_c(
             1,
-            b"A\0".as_ptr().cast::<c_char>(),
+            c"A".as_ptr(),
             select.as_ptr(),
             d.as_mut_ptr(),
             z.as_mut_ptr(),
@@ -215,7 +216,7 @@ fn run(
             &mut info_e,
         );
     }
-    drop(_guard);
+    drop(guard);
     if info_e != 0 {
         return Err(ArpackError::from_info(
             Routine::Dseupd,

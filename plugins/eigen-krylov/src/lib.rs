@@ -45,7 +45,7 @@
 //! **Full reorthogonalization.** Every new vector is orthogonalized against *all* basis
 //! vectors (and all locked vectors, below) by classical Gram-Schmidt applied twice in the
 //! `M` inner product (Daniel, Gragg, Kaufman & Stewart 1976, "twice is enough"), a third
-//! pass being added when the second one still removes most of the vector. Only the
+//! pass being added when less than `1e-6` of the vector's `M`-norm survives. Only the
 //! diagonal coefficient `alpha_j` and the norm `beta_j` enter `T`; the other
 //! coefficients are rounding-level corrections. Semi-orthogonality is therefore never
 //! lost and no spurious copies of converged eigenvalues appear.
@@ -187,48 +187,60 @@ impl SymmetricKernel for LanczosKernel {
                 format!("relative tolerance must be in (0, 1), got {tol}"),
             ));
         }
-        let nev = nev.min(n);
-        let mut ctx = Ctx {
-            op,
-            tol,
-            max_restarts,
-            restarts: 0,
-            dirs: Directions::new(),
-        };
-        if nev == 0 {
-            return Ok(Pairs::new(n).into_output(0, true));
-        }
-
-        // First run: the nev largest Ritz pairs of one Krylov space.
         let start: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
-        let first = ctx.run(&Pairs::new(n), nev, start, None)?;
-        let mut found = first.pairs;
-        if !first.complete {
+        largest_from(op, nev, tol, max_restarts, start)
+    }
+}
+
+/// [`LanczosKernel::largest`] from a given start vector.
+fn largest_from(
+    op: &ShiftInvert<'_>,
+    nev: usize,
+    tol: f64,
+    max_restarts: usize,
+    start: Vec<f64>,
+) -> Result<KernelOutput> {
+    let n = op.dim();
+    let nev = nev.min(n);
+    let mut ctx = Ctx {
+        op,
+        tol,
+        max_restarts,
+        restarts: 0,
+        dirs: Directions::new(),
+    };
+    if nev == 0 {
+        return Ok(Pairs::new(n).into_output(0, true));
+    }
+
+    // First run: the nev largest Ritz pairs of one Krylov space.
+    let first = ctx.run(&Pairs::new(n), nev, start, None)?;
+    let mut found = first.pairs;
+    if !first.complete {
+        return Ok(found.into_output(ctx.restarts, false));
+    }
+
+    // Validation runs in the M-complement of what was found: any eigenvalue larger
+    // than the smallest found one (a missed copy of a repeated eigenvalue) is merged.
+    let margin = (10.0 * tol).clamp(1e-10, 1e-4);
+    loop {
+        if found.len() >= n {
+            return Ok(found.into_output(ctx.restarts, true));
+        }
+        if ctx.restarts >= ctx.max_restarts {
             return Ok(found.into_output(ctx.restarts, false));
         }
-
-        // Validation runs in the M-complement of what was found: any eigenvalue larger
-        // than the smallest found one (a missed copy of a repeated eigenvalue) is merged.
-        let margin = (10.0 * tol).clamp(1e-10, 1e-4);
-        loop {
-            if found.len() >= n {
-                return Ok(found.into_output(ctx.restarts, true));
-            }
-            if ctx.restarts >= ctx.max_restarts {
-                return Ok(found.into_output(ctx.restarts, false));
-            }
-            ctx.restarts += 1;
-            let floor = found.min_theta() * (1.0 + margin);
-            let start = ctx.dirs.vector(n);
-            let check = ctx.run(&found, nev, start, Some(floor))?;
-            let above = check.pairs.filtered(|t| t > floor);
-            if above.len() == 0 {
-                return Ok(found.into_output(ctx.restarts, check.complete));
-            }
-            found = Pairs::merged(&found, &above, nev);
-            if !check.complete {
-                return Ok(found.into_output(ctx.restarts, false));
-            }
+        ctx.restarts += 1;
+        let floor = found.min_theta() * (1.0 + margin);
+        let start = ctx.dirs.vector(n);
+        let check = ctx.run(&found, nev, start, Some(floor))?;
+        let above = check.pairs.filtered(|t| t > floor);
+        if above.len() == 0 {
+            return Ok(found.into_output(ctx.restarts, check.complete));
+        }
+        found = Pairs::merged(&found, &above, nev);
+        if !check.complete {
+            return Ok(found.into_output(ctx.restarts, false));
         }
     }
 }
@@ -470,10 +482,18 @@ struct Ritz {
     wanted: Vec<usize>,
     /// Convergence flag of each pair.
     converged: Vec<bool>,
+    /// The basis is too small to hold every wanted pair.
+    short: bool,
 }
 
 impl Ritz {
+    /// Every wanted pair present and converged.
     fn done(&self) -> bool {
+        !self.short && self.all_converged()
+    }
+
+    /// Every wanted pair the basis holds is converged.
+    fn all_converged(&self) -> bool {
         self.wanted.iter().all(|&i| self.converged[i])
     }
 }
@@ -560,14 +580,14 @@ impl Ctx<'_, '_> {
         let count = match floor {
             None => want,
             Some(f) => (theta.iter().filter(|&&t| t > f).count() + 1).min(want),
-        }
-        .min(m);
-        let wanted = (0..count).map(|r| m - 1 - r).collect();
+        };
+        let wanted = (0..count.min(m)).map(|r| m - 1 - r).collect();
         Ok(Ritz {
             theta,
             y,
             wanted,
             converged,
+            short: count > m,
         })
     }
 
@@ -636,9 +656,17 @@ impl Ctx<'_, '_> {
                     h.iter_mut().zip(&h3).for_each(|(a, c)| *a += c);
                     b = self.m_norm(&w, &mut mw);
                 }
+                if !(b.is_finite() && h[j].is_finite()) {
+                    return Err(Error::Invalid(format!(
+                        "krylov: non-finite Lanczos coefficient at step {j} (alpha = {}, \
+                         beta = {b}): the factorization of K - sigma M is unusable",
+                        h[j]
+                    )));
+                }
                 t[(j, j)] = h[j];
                 let mut exhausted = false;
-                if b > BREAKDOWN * norm0 {
+                let broke = b <= BREAKDOWN * norm0;
+                if !broke {
                     w.iter_mut().for_each(|v| *v /= b);
                     mw.iter_mut().for_each(|v| *v /= b);
                     basis.set(j + 1, &w, &mw);
@@ -657,11 +685,14 @@ impl Ctx<'_, '_> {
                     t[(j + 1, j)] = b;
                     t[(j, j + 1)] = b;
                 }
+                // Early checks skip breakdown steps: an invariant subspace has exact Ritz
+                // pairs that need not be the largest; the new direction may show more.
                 let size = j + 1;
-                if exhausted || size == ncv || (size - k) % CHECK_EVERY == 0 {
+                if exhausted || size == ncv || (!broke && (size - k) % CHECK_EVERY == 0) {
                     let r = self.ritz(&t, size, beta, want, floor)?;
                     if r.done() || exhausted {
-                        let complete = r.done();
+                        // Exhausted: the basis spans the whole complement, nothing is missing.
+                        let complete = r.all_converged();
                         return Ok(RunOut {
                             pairs: self.converged_pairs(&basis, size, &r),
                             complete,

@@ -1,0 +1,498 @@
+//! Unit tests against closed forms and the dense oracle.
+
+use super::*;
+use squeal_core::eigen::dense_symmetric;
+use squeal_core::faer::sparse::Triplet;
+use squeal_core::{SparseMat, StopReason};
+use std::f64::consts::PI;
+
+const K: f64 = 1.0e6; // N/m
+const MASS: f64 = 1.0; // kg
+
+fn sparse(n: usize, trip: &[Triplet<usize, usize, f64>]) -> SparseMat {
+    SparseMat::try_new_from_triplets(n, n, trip).unwrap()
+}
+
+/// Stiffness triplets of a spring chain of `n` masses starting at DOF `offset`;
+/// spring `s` (0..=n) joins node `s - 1` and node `s`, the ends to the ground if fixed.
+fn chain_k(
+    trip: &mut Vec<Triplet<usize, usize, f64>>,
+    offset: usize,
+    n: usize,
+    spring: impl Fn(usize) -> f64,
+    fixed: bool,
+) {
+    for s in 0..=n {
+        let ks = spring(s);
+        let (a, b) = (s.checked_sub(1), (s < n).then_some(s));
+        match (a, b) {
+            (Some(a), Some(b)) => {
+                trip.push(Triplet::new(offset + a, offset + a, ks));
+                trip.push(Triplet::new(offset + b, offset + b, ks));
+                trip.push(Triplet::new(offset + a, offset + b, -ks));
+                trip.push(Triplet::new(offset + b, offset + a, -ks));
+            }
+            (Some(e), None) | (None, Some(e)) if fixed => {
+                trip.push(Triplet::new(offset + e, offset + e, ks));
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Lumped (`m I`) or consistent (`m/6 (1, 4, 1)`) mass of a chain at `offset`.
+fn chain_m(trip: &mut Vec<Triplet<usize, usize, f64>>, offset: usize, n: usize, consistent: bool) {
+    for i in 0..n {
+        if consistent {
+            trip.push(Triplet::new(offset + i, offset + i, 4.0 * MASS / 6.0));
+            if i + 1 < n {
+                trip.push(Triplet::new(offset + i, offset + i + 1, MASS / 6.0));
+                trip.push(Triplet::new(offset + i + 1, offset + i, MASS / 6.0));
+            }
+        } else {
+            trip.push(Triplet::new(offset + i, offset + i, MASS));
+        }
+    }
+}
+
+/// `omega^2` of mode `j` of a uniform chain: `(2k/m)(1 - cos(j pi / d))`, written as
+/// `(4k/m) sin^2(j pi / 2d)` to avoid cancellation (`d = n + 1` fixed, `n` free).
+fn closed_form(j: usize, d: usize) -> f64 {
+    4.0 * K / MASS * (j as f64 * PI / (2.0 * d as f64)).sin().powi(2)
+}
+
+fn hz(omega2: f64) -> f64 {
+    omega2.max(0.0).sqrt() / (2.0 * PI)
+}
+
+fn params(fmax_hz: f64) -> EigenParams {
+    EigenParams {
+        dense_below: 0,
+        fmax_hz,
+        ..Default::default()
+    }
+}
+
+fn solve(k: &SparseMat, m: &SparseMat, p: &EigenParams) -> RealModes {
+    let problem = SymmetricProblem {
+        k: k.as_ref(),
+        m: m.as_ref(),
+    };
+    let modes = KrylovSolver.solve_symmetric(&problem, p).unwrap();
+    eprintln!(
+        "n = {}: {} modes, {} restarts, {} op applications, reason {:?}, max residual {:.2e}, notes {:?}",
+        k.nrows(),
+        modes.omega2.len(),
+        modes.info.iterations,
+        modes.info.op_applications,
+        modes.info.reason,
+        modes.residuals.iter().copied().fold(0.0, f64::max),
+        modes.info.notes,
+    );
+    modes
+}
+
+fn assert_residuals(modes: &RealModes) {
+    for (i, r) in modes.residuals.iter().enumerate() {
+        assert!(*r < 1e-10, "mode {i}: residual {r:e}");
+    }
+}
+
+/// `X^T M X = I` to `tol`.
+fn assert_m_orthonormal(x: &Mat<f64>, m: &SparseMat, tol: f64) {
+    let n = x.nrows();
+    let mut mx = vec![0.0; n];
+    for a in 0..x.ncols() {
+        let xa: Vec<f64> = (0..n).map(|i| x[(i, a)]).collect();
+        squeal_core::linalg::spmv(m.as_ref(), &xa, &mut mx);
+        for b in 0..x.ncols() {
+            let g: f64 = (0..n).map(|i| x[(i, b)] * mx[i]).sum();
+            let expected = if a == b { 1.0 } else { 0.0 };
+            assert!((g - expected).abs() < tol, "(X^T M X)[{a}, {b}] = {g:e}");
+        }
+    }
+}
+
+fn max_rel_err(got: &[f64], want: &[f64]) -> f64 {
+    assert_eq!(got.len(), want.len());
+    got.iter()
+        .zip(want)
+        .map(|(g, w)| (g - w).abs() / w.abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn fixed_chain_matches_closed_form() {
+    let n = 300;
+    let (mut kt, mut mt) = (Vec::new(), Vec::new());
+    chain_k(&mut kt, 0, n, |_| K, true);
+    chain_m(&mut mt, 0, n, false);
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    let fmax = 0.5 * (hz(closed_form(20, n + 1)) + hz(closed_form(21, n + 1)));
+    let modes = solve(&k, &m, &params(fmax));
+    let want: Vec<f64> = (1..=20).map(|j| closed_form(j, n + 1)).collect();
+    let err = max_rel_err(&modes.omega2, &want);
+    eprintln!("fixed chain: max relative error {err:.2e}");
+    assert!(err < 1e-10, "max relative error {err:e}");
+    assert_residuals(&modes);
+    assert_eq!(modes.info.reason, StopReason::Converged);
+    assert_eq!(modes.info.solver, "krylov");
+    assert_m_orthonormal(&modes.vectors, &m, 1e-10);
+    for (f, w) in modes.freq_hz.iter().zip(&want) {
+        assert!((f - hz(*w)).abs() < 1e-9 * hz(*w));
+    }
+}
+
+#[test]
+fn identical_chains_give_every_eigenvalue_twice() {
+    let half = 150;
+    let n = 2 * half;
+    let (mut kt, mut mt) = (Vec::new(), Vec::new());
+    for off in [0, half] {
+        chain_k(&mut kt, off, half, |_| K, true);
+        chain_m(&mut mt, off, half, false);
+    }
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    // 12 distinct frequencies, 24 modes: the first request (24 pairs) stays inside the
+    // band, so the driver also grows its request.
+    let fmax = 0.5 * (hz(closed_form(12, half + 1)) + hz(closed_form(13, half + 1)));
+    let modes = solve(&k, &m, &params(fmax));
+    let want: Vec<f64> = (1..=12)
+        .flat_map(|j| [closed_form(j, half + 1); 2])
+        .collect();
+    assert_eq!(modes.omega2.len(), want.len(), "{:?}", modes.omega2);
+    let err = max_rel_err(&modes.omega2, &want);
+    eprintln!("identical chains: max relative error {err:.2e}");
+    assert!(err < 1e-10, "max relative error {err:e}");
+    assert_residuals(&modes);
+    assert_eq!(modes.info.reason, StopReason::Converged);
+    // The two copies are genuinely different (M-orthogonal) vectors.
+    assert_m_orthonormal(&modes.vectors, &m, 1e-9);
+}
+
+#[test]
+fn consistent_mass_doublets_match_dense_oracle() {
+    let half = 100;
+    let n = 2 * half;
+    let spring = |s: usize| K * (1.0 + 0.3 * (s as f64).sin());
+    let (mut kt, mut mt) = (Vec::new(), Vec::new());
+    for off in [0, half] {
+        chain_k(&mut kt, off, half, spring, true);
+        chain_m(&mut mt, off, half, true);
+    }
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    let problem = SymmetricProblem {
+        k: k.as_ref(),
+        m: m.as_ref(),
+    };
+    let (mut dense, _) = dense_symmetric(&problem).unwrap();
+    dense.sort_by(f64::total_cmp);
+    // Exact doublets by construction.
+    for p in 0..10 {
+        assert!((dense[2 * p] - dense[2 * p + 1]).abs() < 1e-9 * dense[2 * p]);
+    }
+    let count = 30;
+    let fmax = 0.5 * (hz(dense[count - 1]) + hz(dense[count]));
+    let modes = solve(&k, &m, &params(fmax));
+    let err = max_rel_err(&modes.omega2, &dense[..count]);
+    eprintln!("consistent-mass doublets: max relative error vs dense {err:.2e}");
+    assert!(err < 1e-10, "max relative error {err:e}");
+    assert_residuals(&modes);
+    assert_m_orthonormal(&modes.vectors, &m, 1e-9);
+}
+
+#[test]
+fn free_chain_has_one_rigid_body_mode() {
+    let n = 300;
+    let (mut kt, mut mt) = (Vec::new(), Vec::new());
+    chain_k(&mut kt, 0, n, |_| K, false);
+    chain_m(&mut mt, 0, n, false);
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    let fmax = 0.5 * (hz(closed_form(15, n)) + hz(closed_form(16, n)));
+    let modes = solve(&k, &m, &params(fmax));
+    assert_eq!(modes.omega2.len(), 16, "{:?}", modes.omega2);
+    // Rigid-body mode: zero to round-off relative to the first elastic mode.
+    assert!(
+        modes.omega2[0].abs() < 1e-9 * closed_form(1, n),
+        "{}",
+        modes.omega2[0]
+    );
+    assert!(modes.freq_hz[0] < 1e-4 * modes.freq_hz[1]);
+    let want: Vec<f64> = (1..16).map(|j| closed_form(j, n)).collect();
+    let err = max_rel_err(&modes.omega2[1..], &want);
+    eprintln!("free chain: max relative error {err:.2e}");
+    assert!(err < 1e-10, "max relative error {err:e}");
+    // The rigid mode is the uniform translation.
+    let x0: Vec<f64> = (0..n).map(|i| modes.vectors[(i, 0)]).collect();
+    let mean = x0.iter().sum::<f64>() / n as f64;
+    assert!(x0.iter().all(|v| (v - mean).abs() < 1e-8 * mean.abs()));
+    assert_residuals(&modes);
+}
+
+/// True eigenvalues of the fixed chain of `n` masses.
+fn fixed_chain_spectrum(n: usize) -> Vec<f64> {
+    (1..=n).map(|j| closed_form(j, n + 1)).collect()
+}
+
+/// Every value is within `tol` (relative) of an exact eigenvalue.
+fn assert_true_eigenvalues(values: &[f64], exact: &[f64], tol: f64) {
+    for &l in values {
+        let nearest = exact
+            .iter()
+            .map(|e| (e - l).abs() / e)
+            .fold(f64::INFINITY, f64::min);
+        assert!(nearest < tol, "{l} is not an eigenvalue ({nearest:e})");
+    }
+}
+
+#[test]
+fn restart_cap_reports_non_convergence() {
+    let n = 300;
+    let (mut kt, mut mt) = (Vec::new(), Vec::new());
+    chain_k(&mut kt, 0, n, |_| K, true);
+    chain_m(&mut mt, 0, n, false);
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    let exact = fixed_chain_spectrum(n);
+    let fmax = 0.5 * (hz(exact[19]) + hz(exact[20]));
+
+    // Default shift: one restart converges the 24 pairs, but the validation run that
+    // would look for missed copies cannot start, so convergence is not claimed.
+    let p = EigenParams {
+        max_restarts: 1,
+        ..params(fmax)
+    };
+    let modes = solve(&k, &m, &p);
+    assert_eq!(modes.info.reason, StopReason::MaxIterations);
+    assert!(modes.info.iterations <= 1);
+    assert_true_eigenvalues(&modes.omega2, &exact, 1e-10);
+    assert_residuals(&modes);
+
+    // A shift at the band top separates the wanted theta poorly: after one restart
+    // only part of the request has converged, and only that part is returned.
+    let p = EigenParams {
+        max_restarts: 1,
+        shift_hz: Some(fmax),
+        ..params(fmax)
+    };
+    let modes = solve(&k, &m, &p);
+    assert_eq!(modes.info.reason, StopReason::MaxIterations);
+    assert!(
+        modes.info.converged < modes.info.requested,
+        "{:?}",
+        modes.info
+    );
+    assert!(modes.info.iterations <= 1);
+    assert_true_eigenvalues(&modes.omega2, &exact, 1e-10);
+    assert_residuals(&modes);
+
+    // Kernel level, no restart at all: fewer pairs than requested, all of them exact.
+    let sigma = -exact[0];
+    let op = ShiftInvert::new(k.as_ref(), m.as_ref(), sigma).unwrap();
+    let out = LanczosKernel.largest(&op, 24, 1e-12, 0).unwrap();
+    assert!(!out.all_converged);
+    assert_eq!(out.iterations, 0);
+    assert!(out.theta.len() < 24, "{}", out.theta.len());
+    let lam: Vec<f64> = out.theta.iter().map(|&t| op.lambda_of_theta(t)).collect();
+    assert_true_eigenvalues(&lam, &exact, 1e-10);
+}
+
+#[test]
+fn high_multiplicity_through_breakdowns() {
+    // M = I, K = diag with three values of multiplicity 20 each: the Krylov space of
+    // any vector has dimension 3, so every step past the third is a breakdown.
+    let n = 60;
+    let kt: Vec<_> = (0..n)
+        .map(|i| Triplet::new(i, i, [1.0, 4.0, 9.0][i % 3] * 1e4))
+        .collect();
+    let mt: Vec<_> = (0..n).map(|i| Triplet::new(i, i, 1.0)).collect();
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    let fmax = hz(6.0e4);
+    let modes = solve(&k, &m, &params(fmax));
+    assert_eq!(modes.omega2.len(), 40, "{:?}", modes.omega2);
+    for (i, l) in modes.omega2.iter().enumerate() {
+        let want = if i < 20 { 1e4 } else { 4e4 };
+        assert!((l - want).abs() < 1e-10 * want, "mode {i}: {l}");
+    }
+    assert_residuals(&modes);
+    assert_eq!(modes.info.reason, StopReason::Converged);
+    assert_m_orthonormal(&modes.vectors, &m, 1e-10);
+}
+
+#[test]
+fn kernel_is_deterministic_and_finds_the_largest() {
+    let n = 200;
+    let (mut kt, mut mt) = (Vec::new(), Vec::new());
+    chain_k(
+        &mut kt,
+        0,
+        n,
+        |s| K * (1.0 + 0.5 * (0.37 * s as f64).cos()),
+        true,
+    );
+    chain_m(&mut mt, 0, n, true);
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    let sigma = -1.0e3;
+    let op = ShiftInvert::new(k.as_ref(), m.as_ref(), sigma).unwrap();
+    let nev = 12;
+    let a = LanczosKernel.largest(&op, nev, 1e-12, 300).unwrap();
+    let b = LanczosKernel.largest(&op, nev, 1e-12, 300).unwrap();
+    assert!(a.all_converged);
+    assert_eq!(a.theta.len(), nev);
+    assert_eq!(a.theta, b.theta);
+    assert_eq!(a.iterations, b.iterations);
+    assert!(a.vectors == b.vectors);
+    eprintln!(
+        "kernel: {} restarts, {} applications for two calls",
+        a.iterations,
+        op.applications()
+    );
+
+    let problem = SymmetricProblem {
+        k: k.as_ref(),
+        m: m.as_ref(),
+    };
+    let (mut dense, _) = dense_symmetric(&problem).unwrap();
+    dense.sort_by(f64::total_cmp);
+    let mut theta = a.theta.clone();
+    theta.sort_by(|x, y| y.total_cmp(x));
+    for (t, l) in theta.iter().zip(&dense) {
+        let want = 1.0 / (l - sigma);
+        assert!((t - want).abs() < 1e-11 * want, "{t} vs {want}");
+    }
+}
+
+#[test]
+fn kernel_handles_tiny_problems_and_full_requests() {
+    let n = 7;
+    let (mut kt, mut mt) = (Vec::new(), Vec::new());
+    chain_k(&mut kt, 0, n, |_| K, true);
+    chain_m(&mut mt, 0, n, false);
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    let op = ShiftInvert::new(k.as_ref(), m.as_ref(), -1.0).unwrap();
+    for nev in [0, 1, 6, 7, 9] {
+        let out = LanczosKernel.largest(&op, nev, 1e-12, 50).unwrap();
+        assert!(out.all_converged, "nev = {nev}");
+        assert_eq!(out.theta.len(), nev.min(n));
+        let mut theta = out.theta.clone();
+        theta.sort_by(|x, y| y.total_cmp(x));
+        for (j, t) in theta.iter().enumerate() {
+            let want = 1.0 / (closed_form(j + 1, n + 1) + 1.0);
+            assert!((t - want).abs() < 1e-12 * want, "nev = {nev}, j = {j}");
+        }
+    }
+    assert!(LanczosKernel.largest(&op, 3, 0.0, 50).is_err());
+}
+
+#[test]
+fn registered_with_no_parameters() {
+    let mut reg = Registry::new();
+    register(&mut reg);
+    assert_eq!(reg.eigen.names(), vec!["krylov".to_string()]);
+    let (name, desc) = &reg.eigen.describe()[0];
+    assert_eq!(name, "krylov");
+    assert!(desc.contains("Lanczos"));
+    let solver = reg.eigen.create("krylov", &Params::new()).unwrap();
+    assert_eq!(solver.name(), "krylov");
+    let e = reg
+        .eigen
+        .create("krylov", &Params::new().with_num("ncv", 40.0))
+        .err()
+        .expect("unknown parameter must be rejected")
+        .to_string();
+    assert!(e.contains("ncv"), "{e}");
+}
+
+#[test]
+fn validation_recovers_copies_invisible_to_the_first_krylov_space() {
+    // Two identical chains and a start vector identical on both: every Krylov vector is
+    // symmetric, so the antisymmetric copy of each doublet is invisible to the first run.
+    let half = 150;
+    let n = 2 * half;
+    let (mut kt, mut mt) = (Vec::new(), Vec::new());
+    for off in [0, half] {
+        chain_k(&mut kt, off, half, |_| K, true);
+        chain_m(&mut mt, off, half, false);
+    }
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    let exact: Vec<f64> = (1..=half).map(|j| closed_form(j, half + 1)).collect();
+    let sigma = -exact[0];
+    let op = ShiftInvert::new(k.as_ref(), m.as_ref(), sigma).unwrap();
+    let start: Vec<f64> = (0..n)
+        .map(|i| 1.0 + 0.1 * ((i % half) as f64).sin())
+        .collect();
+    let nev = 24;
+
+    let mut ctx = Ctx {
+        op: &op,
+        tol: 1e-12,
+        max_restarts: 300,
+        restarts: 0,
+        dirs: Directions::new(),
+    };
+    let first = ctx.run(&Pairs::new(n), nev, start.clone(), None).unwrap();
+    assert!(first.complete);
+    let mut lam: Vec<f64> = first
+        .pairs
+        .theta
+        .iter()
+        .map(|&t| op.lambda_of_theta(t))
+        .collect();
+    lam.sort_by(f64::total_cmp);
+    // The first run alone: one copy of each of the 24 lowest distinct values.
+    assert!(max_rel_err(&lam, &exact[..nev]) < 1e-10, "{lam:?}");
+
+    let out = largest_from(&op, nev, 1e-12, 300, start).unwrap();
+    assert!(out.all_converged);
+    let mut lam: Vec<f64> = out.theta.iter().map(|&t| op.lambda_of_theta(t)).collect();
+    lam.sort_by(f64::total_cmp);
+    let want: Vec<f64> = exact[..nev / 2].iter().flat_map(|&l| [l, l]).collect();
+    let err = max_rel_err(&lam, &want);
+    eprintln!(
+        "symmetric start: {} restarts, {} applications, max relative error {err:.2e}",
+        out.iterations,
+        op.applications()
+    );
+    assert!(err < 1e-10, "{lam:?}");
+}
+
+#[test]
+fn square_membrane_doublets_match_closed_form() {
+    // Fixed square grid of springs: K = k (T x I + I x T), M = m I. Modes (i, j) and
+    // (j, i) are exact doublets, coupled through the whole matrix (no block structure).
+    let g = 25;
+    let n = g * g;
+    let id = |r: usize, c: usize| r * g + c;
+    let mut kt = Vec::new();
+    for r in 0..g {
+        for c in 0..g {
+            kt.push(Triplet::new(id(r, c), id(r, c), 4.0 * K));
+            if c + 1 < g {
+                kt.push(Triplet::new(id(r, c), id(r, c + 1), -K));
+                kt.push(Triplet::new(id(r, c + 1), id(r, c), -K));
+            }
+            if r + 1 < g {
+                kt.push(Triplet::new(id(r, c), id(r + 1, c), -K));
+                kt.push(Triplet::new(id(r + 1, c), id(r, c), -K));
+            }
+        }
+    }
+    let mut mt = Vec::new();
+    chain_m(&mut mt, 0, n, false);
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    let mut exact: Vec<f64> = (1..=g)
+        .flat_map(|i| (1..=g).map(move |j| closed_form(i, g + 1) + closed_form(j, g + 1)))
+        .collect();
+    exact.sort_by(f64::total_cmp);
+    // Band top between two distinct values, about 40 modes.
+    let count = (40..exact.len())
+        .find(|&c| exact[c] > exact[c - 1] * (1.0 + 1e-6))
+        .unwrap();
+    let fmax = 0.5 * (hz(exact[count - 1]) + hz(exact[count]));
+    let modes = solve(&k, &m, &params(fmax));
+    let err = max_rel_err(&modes.omega2, &exact[..count]);
+    eprintln!("membrane: {count} modes, max relative error {err:.2e}");
+    assert!(err < 1e-10, "max relative error {err:e}");
+    assert_residuals(&modes);
+    assert_eq!(modes.info.reason, StopReason::Converged);
+    assert_m_orthonormal(&modes.vectors, &m, 1e-9);
+}
