@@ -177,7 +177,7 @@ pub fn solve_symmetric_band(
     };
     let top = (two_pi * params.fmax_hz).powi(2);
 
-    let (omega2, vectors) = if n <= params.dense_below {
+    let (omega2, vectors) = if n <= params.dense_below.max(2) {
         info.notes.push(format!(
             "n = {n} <= {}: solved densely instead of `{solver}`",
             params.dense_below
