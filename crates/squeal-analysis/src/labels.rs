@@ -6,7 +6,9 @@
 //! weights = element volume shares); `n` is the circumferential harmonic holding most
 //! of that component's energy (Parseval over each ring of nodes); `m` is the number of
 //! sign changes along the radius of the axial harmonic-`n` profile on the friction face,
-//! after aligning its phase and ignoring values below 10 % of the peak.
+//! after aligning its phase and ignoring values below 10 % of the peak. In-plane modes
+//! with one nodal diameter (a translation of the ring: radial and circumferential
+//! energies equal) are called `c,1`, as in the paper.
 //!
 //! **Pin** (pin + plates): the pin block's best-fit rigid motion `t + w x (x - c)`
 //! names the mode: `shift-x`, `shift-y`, `bounce-z`, `tilt-x`, `tilt-y` (rotation about
@@ -86,7 +88,9 @@ pub fn label_disc(mesh: &Mesh, weights: &[f64], nodes: &[usize], u: &[f64]) -> D
             (r, th, p[2], v)
         })
         .collect();
-    let comp = (0..3).max_by(|&a, &b| energy[a].total_cmp(&energy[b])).unwrap();
+    let comp = (0..3)
+        .max_by(|&a, &b| energy[a].total_cmp(&energy[b]))
+        .unwrap();
     let kind = ['r', 'c', 'a'][comp];
     // rings of nodes: same (r, z)
     let key = |r: f64, z: f64| ((r * 1e7).round() as i64, (z * 1e7).round() as i64);
@@ -108,7 +112,11 @@ pub fn label_disc(mesh: &Mesh, weights: &[f64], nodes: &[usize], u: &[f64]) -> D
         for (&(_, _), ring) in &rings {
             let w = weights[nodes[ring[0]]];
             let (re, im) = coeff(ring, n, comp);
-            let factor = if n == 0 || 2 * n == ring.len() { 1.0 } else { 2.0 };
+            let factor = if n == 0 || 2 * n == ring.len() {
+                1.0
+            } else {
+                2.0
+            };
             e += w * factor * (re * re + im * im);
         }
         if e > best.1 {
@@ -116,6 +124,13 @@ pub fn label_disc(mesh: &Mesh, weights: &[f64], nodes: &[usize], u: &[f64]) -> D
         }
     }
     let diameters = best.0;
+    // In-plane motion with one nodal diameter is the ring's translation, with equal
+    // radial and circumferential energy; the paper (and common usage) calls it c,1.
+    let kind = if kind == 'r' && diameters == 1 {
+        'c'
+    } else {
+        kind
+    };
     let circles = (kind == 'a').then(|| {
         let ztop = cyl.iter().map(|c| c.2).fold(f64::NEG_INFINITY, f64::max);
         let face: Vec<(f64, (f64, f64))> = rings
@@ -128,9 +143,16 @@ pub fn label_disc(mesh: &Mesh, weights: &[f64], nodes: &[usize], u: &[f64]) -> D
             (a + re * re - im * im, b + 2.0 * re * im)
         });
         let phi = 0.5 * si.atan2(sr);
-        let prof: Vec<f64> = face.iter().map(|(_, (re, im))| re * phi.cos() + im * phi.sin()).collect();
+        let prof: Vec<f64> = face
+            .iter()
+            .map(|(_, (re, im))| re * phi.cos() + im * phi.sin())
+            .collect();
         let peak = prof.iter().fold(0.0f64, |a, &b| a.max(b.abs()));
-        let signs: Vec<bool> = prof.iter().filter(|v| v.abs() > 0.1 * peak).map(|&v| v > 0.0).collect();
+        let signs: Vec<bool> = prof
+            .iter()
+            .filter(|v| v.abs() > 0.1 * peak)
+            .map(|&v| v > 0.0)
+            .collect();
         signs.windows(2).filter(|w| w[0] != w[1]).count()
     });
     DiscLabel {
@@ -154,7 +176,11 @@ pub fn label_pin(mesh: &Mesh, pin_nodes: &[usize], u: &[f64]) -> String {
     let mut b = [0.0; 6];
     let mut size: f64 = 0.0;
     for &p in pin_nodes {
-        let d = [mesh.nodes[p][0] - c[0], mesh.nodes[p][1] - c[1], mesh.nodes[p][2] - c[2]];
+        let d = [
+            mesh.nodes[p][0] - c[0],
+            mesh.nodes[p][1] - c[1],
+            mesh.nodes[p][2] - c[2],
+        ];
         size = size.max(d[0].abs()).max(d[1].abs());
         // rows: u_x = t_x + w_y d_z - w_z d_y, etc.
         let rows = [
@@ -180,14 +206,20 @@ pub fn label_pin(mesh: &Mesh, pin_nodes: &[usize], u: &[f64]) -> String {
         x[4].abs() * size,
         x[5].abs() * size,
     ];
-    let names = ["shift-x", "shift-y", "bounce-z", "tilt-x", "tilt-y", "twist-z"];
-    let i = (0..6).max_by(|&i, &j| score[i].total_cmp(&score[j])).unwrap();
+    let names = [
+        "shift-x", "shift-y", "bounce-z", "tilt-x", "tilt-y", "twist-z",
+    ];
+    let i = (0..6)
+        .max_by(|&i, &j| score[i].total_cmp(&score[j]))
+        .unwrap();
     names[i].to_string()
 }
 
 fn solve6(mut a: [[f64; 6]; 6], mut b: [f64; 6]) -> [f64; 6] {
     for c in 0..6 {
-        let p = (c..6).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs())).unwrap();
+        let p = (c..6)
+            .max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))
+            .unwrap();
         a.swap(c, p);
         b.swap(c, p);
         let piv = a[c][c];
@@ -205,7 +237,11 @@ fn solve6(mut a: [[f64; 6]; 6], mut b: [f64; 6]) -> [f64; 6] {
     let mut x = [0.0; 6];
     for c in (0..6).rev() {
         let s: f64 = (c + 1..6).map(|j| a[c][j] * x[j]).sum();
-        x[c] = if a[c][c].abs() < 1e-300 { 0.0 } else { (b[c] - s) / a[c][c] };
+        x[c] = if a[c][c].abs() < 1e-300 {
+            0.0
+        } else {
+            (b[c] - s) / a[c][c]
+        };
     }
     x
 }
@@ -236,19 +272,38 @@ mod tests {
             }
             u
         };
-        let l = label_disc(&m, &w, &nodes, &field(&|r, th| [0.0, 0.0, (r - 0.05) * (3.0 * th + 0.3).cos()]));
+        let l = label_disc(
+            &m,
+            &w,
+            &nodes,
+            &field(&|r, th| [0.0, 0.0, (r - 0.05) * (3.0 * th + 0.3).cos()]),
+        );
         assert_eq!(l.to_string(), "a,0,3");
-        let l = label_disc(&m, &w, &nodes, &field(&|r, th| [0.0, 0.0, (r - 0.11) * (2.0 * th).sin()]));
+        let l = label_disc(
+            &m,
+            &w,
+            &nodes,
+            &field(&|r, th| [0.0, 0.0, (r - 0.11) * (2.0 * th).sin()]),
+        );
         assert_eq!(l.to_string(), "a,1,2");
         let l = label_disc(&m, &w, &nodes, &field(&|r, _| [0.0, r, 0.0]));
         assert_eq!(l.to_string(), "c,0");
-        let l = label_disc(&m, &w, &nodes, &field(&|r, th| [r * (2.0 * th).cos(), 0.2 * r * (2.0 * th).sin(), 0.0]));
+        let l = label_disc(
+            &m,
+            &w,
+            &nodes,
+            &field(&|r, th| [r * (2.0 * th).cos(), 0.2 * r * (2.0 * th).sin(), 0.0]),
+        );
         assert_eq!(l.to_string(), "r,2");
     }
 
     #[test]
     fn pin_rigid_motions() {
-        let m = Mesh::block(&linspace(-0.01, 0.01, 2), &linspace(0.09, 0.11, 2), &linspace(0.0, 0.015, 2));
+        let m = Mesh::block(
+            &linspace(-0.01, 0.01, 2),
+            &linspace(0.09, 0.11, 2),
+            &linspace(0.0, 0.015, 2),
+        );
         let nodes: Vec<usize> = (0..m.n_nodes()).collect();
         let mut u = vec![0.0; 3 * m.n_nodes()];
         // rotation about y through the centre: u_x = w z', u_z = -w x'

@@ -47,16 +47,25 @@ pub fn label_modes(model: &Model, modes: &RealModes) -> Vec<ModeRecord> {
     let mesh = &model.mesh;
     let weights = nodal_weights(mesh);
     let body_of = |name: &str| model.body_names.iter().position(|b| b == name);
-    let disc_nodes = body_of("disc").map(|b| mesh.body_nodes(b)).unwrap_or_default();
-    let pin_nodes = body_of("pin").map(|b| mesh.body_nodes(b)).unwrap_or_default();
+    let disc_nodes = body_of("disc")
+        .map(|b| mesh.body_nodes(b))
+        .unwrap_or_default();
+    let pin_nodes = body_of("pin")
+        .map(|b| mesh.body_nodes(b))
+        .unwrap_or_default();
     let mut out: Vec<ModeRecord> = (0..modes.freq_hz.len())
         .map(|i| {
-            let free: Vec<f64> = (0..modes.vectors.nrows()).map(|r| modes.vectors[(r, i)]).collect();
+            let free: Vec<f64> = (0..modes.vectors.nrows())
+                .map(|r| modes.vectors[(r, i)])
+                .collect();
             let u = model.dofs.expand(&free);
             let shares = body_shares(mesh, &weights, &u, model.body_names.len());
             let disc_share = body_of("disc").map(|b| shares[b]).unwrap_or(0.0);
             let (body, label) = if disc_share >= 0.5 {
-                ("disc", label_disc(mesh, &weights, &disc_nodes, &u).to_string())
+                (
+                    "disc",
+                    label_disc(mesh, &weights, &disc_nodes, &u).to_string(),
+                )
             } else {
                 ("pin", label_pin(mesh, &pin_nodes, &u))
             };
@@ -144,13 +153,18 @@ pub fn format_table(rows: &[TableRow]) -> String {
     let mut s = String::from("label    paper (Hz)  squeal (Hz)   error   doublet split\n");
     for r in rows {
         let f = r.squeal_hz.map_or("missing".into(), |v| format!("{v:.1}"));
-        let e = r.rel_err.map_or("-".into(), |v| format!("{:+.2} %", 100.0 * v));
+        let e = r
+            .rel_err
+            .map_or("-".into(), |v| format!("{:+.2} %", 100.0 * v));
         let d = match (r.paper_double, r.doublet_split) {
             (true, Some(x)) => format!("{:.3} %", 100.0 * x),
             (true, None) => "unpaired".into(),
             (false, _) => "single".into(),
         };
-        s.push_str(&format!("{:<8} {:>10.1} {:>12} {:>9}   {}\n", r.label, r.paper_hz, f, e, d));
+        s.push_str(&format!(
+            "{:<8} {:>10.1} {:>12} {:>9}   {}\n",
+            r.label, r.paper_hz, f, e, d
+        ));
     }
     s
 }

@@ -63,7 +63,10 @@ enum Command {
 /// Loads a scene: a file path, else an embedded name, else the default.
 pub fn load_scene(arg: Option<&str>) -> Result<(Scene, String)> {
     match arg {
-        None => Ok((Scene::builtin("pin-on-disc")?, "<builtin pin-on-disc>".into())),
+        None => Ok((
+            Scene::builtin("pin-on-disc")?,
+            "<builtin pin-on-disc>".into(),
+        )),
         Some(a) if std::path::Path::new(a).exists() => {
             Ok((Scene::from_file(std::path::Path::new(a))?, a.to_string()))
         }
@@ -83,7 +86,14 @@ fn run() -> Result<()> {
     let cli = Cli::parse();
     let registry = squeal::registry();
     match cli.command {
-        Command::Modes { scene, body, max_freq, eigen, tol, json } => {
+        Command::Modes {
+            scene,
+            body,
+            max_freq,
+            eigen,
+            tol,
+            json,
+        } => {
             let which = match body {
                 Body::Disc => squeal_scene::BodyKind::Disc,
                 Body::Pin => squeal_scene::BodyKind::Pin,
@@ -96,15 +106,30 @@ fn run() -> Result<()> {
             }
         }
         Command::Validate { scene, eigen, json } => {
-            let report = modes::run(&registry, scene.as_deref(), squeal_scene::BodyKind::Disc, 10_500.0, &eigen, 1e-12)?;
+            let report = modes::run(
+                &registry,
+                scene.as_deref(),
+                squeal_scene::BodyKind::Disc,
+                10_500.0,
+                &eigen,
+                1e-12,
+            )?;
             let rows = squeal_analysis::modal::compare_table2(&report.modes);
             println!("Disc normal modes (free friction face): paper Table 2 vs squeal");
             println!(
                 "model: {} DOFs, {} elements, solved by `{}` in {:.2} s (build {:.2} s)\n",
-                report.dofs, report.elements, report.solver, report.solve_time_s, report.build_time_s
+                report.dofs,
+                report.elements,
+                report.solver,
+                report.solve_time_s,
+                report.build_time_s
             );
             print!("{}", squeal_analysis::modal::format_table(&rows));
-            let within = |t: f64| rows.iter().filter(|r| r.rel_err.is_some_and(|e| e.abs() <= t)).count();
+            let within = |t: f64| {
+                rows.iter()
+                    .filter(|r| r.rel_err.is_some_and(|e| e.abs() <= t))
+                    .count()
+            };
             println!(
                 "\n{} of {} labels found; {} within 5 %, {} within 10 %",
                 rows.iter().filter(|r| r.squeal_hz.is_some()).count(),

@@ -205,8 +205,9 @@ pub fn solve_symmetric_band(
                 break (lam, out.vectors);
             }
             let grown = (nev * 2).min(n - 1);
-            info.notes
-                .push(format!("{nev} pairs all below the band top; retried with {grown}"));
+            info.notes.push(format!(
+                "{nev} pairs all below the band top; retried with {grown}"
+            ));
             nev = grown;
         }
     };
@@ -257,13 +258,19 @@ fn validate_params(p: &EigenParams) -> Result<()> {
     if !(p.fmax_hz.is_finite() && p.fmax_hz > 0.0) {
         return Err(Error::param(
             "fmax_hz",
-            format!("band top must be a positive frequency in Hz, got {}", p.fmax_hz),
+            format!(
+                "band top must be a positive frequency in Hz, got {}",
+                p.fmax_hz
+            ),
         ));
     }
     if !(p.fmin_hz.is_finite() && p.fmin_hz >= 0.0 && p.fmin_hz < p.fmax_hz) {
         return Err(Error::param(
             "fmin_hz",
-            format!("band bottom must be in [0, {}) Hz, got {}", p.fmax_hz, p.fmin_hz),
+            format!(
+                "band bottom must be in [0, {}) Hz, got {}",
+                p.fmax_hz, p.fmin_hz
+            ),
         ));
     }
     if !(p.tol > 0.0 && p.tol < 1.0) {
@@ -299,12 +306,18 @@ pub fn dense_symmetric(problem: &SymmetricProblem<'_>) -> Result<(Vec<f64>, Mat<
         at.as_mut(),
         faer::Par::Seq,
     );
-    let sym = (&at + at.transpose()) * faer::Scale(0.5);
+    // Scale to unit largest entry: faer's divide-and-conquer path (n > 128) returned
+    // wrong pairs for entries of order 1e13 (seen on a free block, faer 0.24.4).
+    let scale = (0..n)
+        .flat_map(|j| (0..n).map(move |i| (i, j)))
+        .fold(0.0f64, |a, (i, j)| a.max(at[(i, j)].abs()))
+        .max(f64::MIN_POSITIVE);
+    let sym = (&at + at.transpose()) * faer::Scale(0.5 / scale);
     let eig = sym
         .self_adjoint_eigen(faer::Side::Lower)
         .map_err(|e| Error::Invalid(format!("dense symmetric eigen failed: {e:?}")))?;
     let s = eig.S();
-    let lam: Vec<f64> = (0..n).map(|i| s[i]).collect();
+    let lam: Vec<f64> = (0..n).map(|i| s[i] * scale).collect();
     let mut x = eig.U().to_owned();
     faer::linalg::triangular_solve::solve_upper_triangular_in_place(
         l.transpose(),

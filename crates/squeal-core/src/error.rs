@@ -2,7 +2,7 @@
 
 use thiserror::Error;
 
-/// Result with the core [`Error`].
+/// Result with the core [`Error`](enum@Error).
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// Everything that can go wrong at the level of the core contracts.

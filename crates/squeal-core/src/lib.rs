@@ -24,7 +24,7 @@ pub mod registry;
 
 pub use contact::{ContactLaw, EquilibriumSolver, ReductionBasis};
 pub use eigen::{
-    solve_symmetric_band, EigenParams, KernelOutput, EigenSolver, RealModes, SolveInfo, StopReason,
+    solve_symmetric_band, EigenParams, EigenSolver, KernelOutput, RealModes, SolveInfo, StopReason,
     SymmetricKernel, SymmetricProblem,
 };
 pub use error::{Error, Result};

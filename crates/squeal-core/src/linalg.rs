@@ -108,14 +108,13 @@ impl<'a> ShiftInvert<'a> {
         };
         let symbolic = SymbolicLlt::try_new(shifted.symbolic(), Side::Lower)
             .map_err(|e| fail(format!("{e:?}")))?;
-        let llt = Llt::try_new_with_symbolic(symbolic, shifted.as_ref(), Side::Lower).map_err(
-            |e| {
+        let llt =
+            Llt::try_new_with_symbolic(symbolic, shifted.as_ref(), Side::Lower).map_err(|e| {
                 fail(format!(
                     "{e:?} (not positive definite: is sigma below the lowest eigenvalue, \
                      and are the rigid-body motions of K restrained or M positive?)"
                 ))
-            },
-        )?;
+            })?;
         Ok(Self {
             m,
             sigma,
@@ -155,14 +154,16 @@ impl<'a> ShiftInvert<'a> {
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
         self.m_mul(x, y);
         self.solve_in_place(y);
-        self.applications.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.applications
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     }
 
     /// `y = (K - sigma M)^-1 b` where `b = M x` is already known (saves one product).
     pub fn apply_with_mx(&self, mx: &[f64], y: &mut [f64]) {
         y.copy_from_slice(mx);
         self.solve_in_place(y);
-        self.applications.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.applications
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     }
 
     /// How many times the operator was applied (a cost measure reported by solvers).
@@ -212,7 +213,10 @@ mod tests {
             .err()
             .expect("indefinite shift must fail")
             .to_string();
-        assert!(e.contains("sigma") && e.contains("positive definite"), "{e}");
+        assert!(
+            e.contains("sigma") && e.contains("positive definite"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -58,7 +58,10 @@ pub fn assemble(mesh: &Mesh, dofs: &DofMap, materials: &[&dyn Material]) -> Resu
     let n = dofs.n_free();
     let (col_ptr, row_idx) = pattern(mesh, dofs);
     let nnz = row_idx.len();
-    let props: Vec<_> = materials.iter().map(|m| (m.elasticity(), m.density())).collect();
+    let props: Vec<_> = materials
+        .iter()
+        .map(|m| (m.elasticity(), m.density()))
+        .collect();
     let threads = rayon::current_num_threads().max(1);
     let chunk = mesh.hexes.len().div_ceil(threads).max(1);
     let parts: Vec<(Vec<f64>, Vec<f64>, f64, f64)> = (0..mesh.hexes.len())
@@ -74,9 +77,8 @@ pub fn assemble(mesh: &Mesh, dofs: &DofMap, materials: &[&dyn Material]) -> Resu
                 let em = hex8_matrices(&mesh.hex_coords(e), d, *rho);
                 mass += rho * em.volume;
                 min_det = min_det.min(em.min_det_j);
-                let free: [Option<usize>; 24] = std::array::from_fn(|a| {
-                    dofs.free_of_full[3 * mesh.hexes[e][a / 3] + a % 3]
-                });
+                let free: [Option<usize>; 24] =
+                    std::array::from_fn(|a| dofs.free_of_full[3 * mesh.hexes[e][a / 3] + a % 3]);
                 for (b, fb) in free.iter().enumerate() {
                     let Some(col) = *fb else { continue };
                     let rows = &row_idx[col_ptr[col]..col_ptr[col + 1]];

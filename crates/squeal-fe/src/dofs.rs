@@ -139,7 +139,10 @@ impl DofMap {
 
     /// All three DOFs of each node in `nodes`, for [`DofMap::new`]'s `fixed`.
     pub fn node_dofs(nodes: &[usize]) -> Vec<usize> {
-        nodes.iter().flat_map(|&n| [3 * n, 3 * n + 1, 3 * n + 2]).collect()
+        nodes
+            .iter()
+            .flat_map(|&n| [3 * n, 3 * n + 1, 3 * n + 2])
+            .collect()
     }
 
     /// Number of free DOFs.
@@ -165,7 +168,11 @@ mod tests {
     #[test]
     fn rcm_is_a_permutation_and_narrows_the_band() {
         // a long thin block numbered along its long axis last: natural order is wide
-        let m = Mesh::block(&linspace(0.0, 1.0, 3), &linspace(0.0, 1.0, 3), &linspace(0.0, 10.0, 40));
+        let m = Mesh::block(
+            &linspace(0.0, 1.0, 3),
+            &linspace(0.0, 1.0, 3),
+            &linspace(0.0, 10.0, 40),
+        );
         let mut m2 = m.clone();
         // scramble node numbering to make the natural band large
         let n = m.n_nodes();
@@ -195,7 +202,11 @@ mod tests {
 
     #[test]
     fn dirichlet_dofs_are_not_numbered() {
-        let m = Mesh::block(&linspace(0.0, 1.0, 1), &linspace(0.0, 1.0, 1), &linspace(0.0, 1.0, 1));
+        let m = Mesh::block(
+            &linspace(0.0, 1.0, 1),
+            &linspace(0.0, 1.0, 1),
+            &linspace(0.0, 1.0, 1),
+        );
         let fixed = DofMap::node_dofs(m.node_set("zmin").unwrap());
         let d = DofMap::new(&m, &fixed);
         assert_eq!(d.n_free(), 12);

@@ -30,7 +30,10 @@ pub fn join(segments: &[Vec<f64>]) -> Vec<f64> {
     let mut out: Vec<f64> = Vec::new();
     for s in segments {
         for &v in s {
-            if out.last().is_none_or(|&l| (v - l).abs() > 1e-12 * (1.0 + v.abs())) {
+            if out
+                .last()
+                .is_none_or(|&l| (v - l).abs() > 1e-12 * (1.0 + v.abs()))
+            {
                 out.push(v);
             }
         }
@@ -136,7 +139,7 @@ impl Mesh {
 
     /// A structured annulus about the z axis: radii `rs` (increasing), `n_theta`
     /// equal sectors (periodic), heights `zs` (increasing), body 0.
-    /// Node sets: `inner` (r = rs[0]), `outer`, `zmin`, `zmax`.
+    /// Node sets: `inner` (r = `rs[0]`), `outer`, `zmin`, `zmax`.
     pub fn annulus(rs: &[f64], n_theta: usize, zs: &[f64]) -> Mesh {
         let (nr, nz) = (rs.len(), zs.len());
         let id = |i: usize, t: usize, k: usize| (k * n_theta + (t % n_theta)) * nr + i;
@@ -263,12 +266,19 @@ impl Mesh {
 
     /// Node set by name, or an error message listing the known sets.
     pub fn node_set(&self, name: &str) -> Result<&[usize], String> {
-        self.node_sets.get(name).map(|v| v.as_slice()).ok_or_else(|| {
-            format!(
-                "no node set `{name}`; known: {}",
-                self.node_sets.keys().cloned().collect::<Vec<_>>().join(", ")
-            )
-        })
+        self.node_sets
+            .get(name)
+            .map(|v| v.as_slice())
+            .ok_or_else(|| {
+                format!(
+                    "no node set `{name}`; known: {}",
+                    self.node_sets
+                        .keys()
+                        .cloned()
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            })
     }
 
     /// Nodes used by elements of `body`, sorted.
@@ -292,7 +302,11 @@ mod tests {
 
     #[test]
     fn block_counts_and_sets() {
-        let m = Mesh::block(&linspace(0.0, 2.0, 4), &linspace(0.0, 1.0, 2), &linspace(0.0, 1.0, 1));
+        let m = Mesh::block(
+            &linspace(0.0, 2.0, 4),
+            &linspace(0.0, 1.0, 2),
+            &linspace(0.0, 1.0, 1),
+        );
         assert_eq!(m.n_nodes(), 5 * 3 * 2);
         assert_eq!(m.hexes.len(), 4 * 2);
         assert_eq!(m.node_set("xmin").unwrap().len(), 3 * 2);
@@ -314,16 +328,28 @@ mod tests {
             let x = m.hex_coords(e);
             let d = |a: usize| [x[a][0] - x[0][0], x[a][1] - x[0][1], x[a][2] - x[0][2]];
             let (a, b, c) = (d(1), d(3), d(4));
-            let cross = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+            let cross = [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ];
             assert!(cross[0] * c[0] + cross[1] * c[1] + cross[2] * c[2] > 0.0);
         }
     }
 
     #[test]
     fn append_glues_coincident_nodes() {
-        let mut a = Mesh::block(&linspace(0.0, 1.0, 2), &linspace(0.0, 1.0, 2), &linspace(0.0, 1.0, 1));
-        let b = Mesh::block(&linspace(0.0, 1.0, 2), &linspace(0.0, 1.0, 2), &linspace(1.0, 2.0, 1))
-            .with_body(1);
+        let mut a = Mesh::block(
+            &linspace(0.0, 1.0, 2),
+            &linspace(0.0, 1.0, 2),
+            &linspace(0.0, 1.0, 1),
+        );
+        let b = Mesh::block(
+            &linspace(0.0, 1.0, 2),
+            &linspace(0.0, 1.0, 2),
+            &linspace(1.0, 2.0, 1),
+        )
+        .with_body(1);
         let map = a.append(&b, "top.", Some(1e-9));
         assert_eq!(a.n_nodes(), 9 * 3);
         assert_eq!(a.hexes.len(), 8);
@@ -338,7 +364,9 @@ mod tests {
     #[test]
     fn volume_of_annulus_and_sheared_block() {
         let m = Mesh::annulus(&linspace(0.05, 0.1, 4), 64, &linspace(0.0, 0.01, 1));
-        let v: f64 = (0..m.hexes.len()).map(|e| hex_volume(&m.hex_coords(e))).sum();
+        let v: f64 = (0..m.hexes.len())
+            .map(|e| hex_volume(&m.hex_coords(e)))
+            .sum();
         // polygonal annulus: n/2 sin(2 pi/n) (R^2 - r^2) h
         let n = 64.0;
         let exact = n / 2.0 * (2.0 * std::f64::consts::PI / n).sin() * (0.01 - 0.0025) * 0.01;

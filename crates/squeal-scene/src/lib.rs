@@ -9,7 +9,7 @@ mod model;
 mod spec;
 
 pub use model::{build, element_size, BodyKind, Model, SizeRule};
-pub use spec::{Disc, MaterialSpec, MeshRule, Pin, Plate, Scene};
+pub use spec::{Disc, Hat, MaterialSpec, MeshRule, Pin, Plate, Scene};
 
 use thiserror::Error;
 
@@ -50,7 +50,7 @@ pub enum SceneError {
         /// What was being built.
         context: String,
         /// Cause.
-        source: squeal_core::Error,
+        source: Box<squeal_core::Error>,
     },
 }
 

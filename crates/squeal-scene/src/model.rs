@@ -63,11 +63,17 @@ pub struct Model {
 }
 
 /// Bending-wave element size for a plate of `thickness` made of `mat` at `freq_hz`.
-pub fn element_size(mat: &dyn Material, thickness: f64, freq_hz: f64, per_wavelength: f64) -> (f64, f64) {
+pub fn element_size(
+    mat: &dyn Material,
+    thickness: f64,
+    freq_hz: f64,
+    per_wavelength: f64,
+) -> (f64, f64) {
     let (e, nu) = in_plane_constants(mat);
     let d = e * thickness.powi(3) / (12.0 * (1.0 - nu * nu));
     let omega = 2.0 * std::f64::consts::PI * freq_hz;
-    let lambda = 2.0 * std::f64::consts::PI * (d / (mat.density() * thickness)).powf(0.25) / omega.sqrt();
+    let lambda =
+        2.0 * std::f64::consts::PI * (d / (mat.density() * thickness)).powf(0.25) / omega.sqrt();
     (lambda, lambda / per_wavelength)
 }
 
@@ -84,7 +90,9 @@ fn invert6(d: [[f64; 6]; 6]) -> [[f64; 6]; 6] {
         row[i] = 1.0;
     }
     for c in 0..6 {
-        let p = (c..6).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs())).unwrap();
+        let p = (c..6)
+            .max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))
+            .unwrap();
         a.swap(c, p);
         inv.swap(c, p);
         let piv = a[c][c];
@@ -123,7 +131,10 @@ fn graded(breaks: &[f64], size: &dyn Fn(f64, f64) -> f64) -> Vec<f64> {
 
 fn within(v: &[f64], lo: f64, hi: f64) -> Vec<f64> {
     let eps = 1e-12 * (1.0 + hi.abs().max(lo.abs()));
-    v.iter().copied().filter(|&x| x >= lo - eps && x <= hi + eps).collect()
+    v.iter()
+        .copied()
+        .filter(|&x| x >= lo - eps && x <= hi + eps)
+        .collect()
 }
 
 /// Builds the bodies of `scene` selected by `which`, with materials from `registry`;
@@ -139,7 +150,7 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             .map_err(|source| SceneError::Core {
                 file: file.into(),
                 context: field.into(),
-                source,
+                source: Box::new(source),
             })
     };
     let missing = |field: &str| SceneError::Field {
@@ -156,24 +167,77 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
     if matches!(which, BodyKind::Disc | BodyKind::All) {
         let d = scene.disc.as_ref().ok_or_else(|| missing("disc"))?;
         let m = mat(&d.material, "disc.material")?;
-        let (lambda, h) = element_size(m.as_ref(), d.thickness_m, rule.max_freq_hz, rule.elements_per_wavelength);
-        let nr = ((d.outer_radius_m - d.inner_radius_m) / h).ceil().max(1.0) as usize;
-        let nt = ((2.0 * std::f64::consts::PI * d.outer_radius_m / h / 4.0).ceil() as usize * 4).max(16);
-        let nz = ((d.thickness_m / h).ceil() as usize).max(rule.min_layers);
-        let disc = Mesh::annulus(
-            &squeal_fe::mesh::linspace(d.inner_radius_m, d.outer_radius_m, nr),
-            nt,
-            &squeal_fe::mesh::linspace(-d.thickness_m, 0.0, nz),
-        )
-        .with_body(materials.len());
-        let map = mesh.append(&disc, "disc.", None);
-        fixed_nodes.extend(disc.node_set("inner").unwrap().iter().map(|&n| map[n]));
+        let (lambda, h) = element_size(
+            m.as_ref(),
+            d.thickness_m,
+            rule.max_freq_hz,
+            rule.elements_per_wavelength,
+        );
+        let nt =
+            ((2.0 * std::f64::consts::PI * d.outer_radius_m / h / 4.0).ceil() as usize * 4).max(16);
+        let body = materials.len();
+        let layer = d.thickness_m / rule.min_layers as f64;
+        let zs = graded(&[-d.thickness_m, 0.0], &|_, _| h.min(layer));
+        // radial grid: the hat wall's radii are grid lines of the ring, so they conform
+        let wall = d.hat.as_ref().map(|hat| {
+            let (lw, hw) = element_size(
+                m.as_ref(),
+                hat.thickness_m,
+                rule.max_freq_hz,
+                rule.elements_per_wavelength,
+            );
+            (lw, hw, hat.thickness_m / rule.min_layers as f64)
+        });
+        let mut rb = vec![d.inner_radius_m, d.outer_radius_m];
+        let r_in_wall = d
+            .hat
+            .as_ref()
+            .and_then(|hat| hat.radius_m)
+            .unwrap_or(d.inner_radius_m);
+        let r_wall = d
+            .hat
+            .as_ref()
+            .map_or(d.inner_radius_m, |hat| r_in_wall + hat.thickness_m);
+        if d.hat.is_some() {
+            rb.extend([r_in_wall, r_wall]);
+        }
+        let rs = graded(&rb, &|lo, hi| match wall {
+            Some((_, _, t)) if lo >= r_in_wall - 1e-12 && hi <= r_wall + 1e-12 => t,
+            _ => h,
+        });
+        let ring = Mesh::annulus(&rs, nt, &zs).with_body(body);
+        let map = mesh.append(&ring, "disc.", None);
+        let mut divisions = [rs.len() - 1, nt, zs.len() - 1];
+        let mut hat_rule = None;
+        match (&d.hat, wall) {
+            (Some(hat), Some((lw, hw, _))) => {
+                let nzh = ((hat.height_m / hw.min(h)).ceil() as usize).max(rule.min_layers);
+                let wall_rs = within(&rs, r_in_wall, r_wall);
+                let hat_mesh = Mesh::annulus(
+                    &wall_rs,
+                    nt,
+                    &squeal_fe::mesh::linspace(-d.thickness_m - hat.height_m, -d.thickness_m, nzh),
+                )
+                .with_body(body);
+                let hmap = mesh.append(&hat_mesh, "disc.hat.", Some(1e-9 * d.outer_radius_m));
+                fixed_nodes.extend(hat_mesh.node_set("zmin").unwrap().iter().map(|&n| hmap[n]));
+                divisions[2] += nzh;
+                hat_rule = Some(SizeRule {
+                    body: "disc hat".into(),
+                    wavelength_m: lw,
+                    element_size_m: hw.min(h),
+                    divisions: [wall_rs.len() - 1, nt, nzh],
+                });
+            }
+            _ => fixed_nodes.extend(ring.node_set("inner").unwrap().iter().map(|&n| map[n])),
+        }
         sizes.push(SizeRule {
             body: "disc".into(),
             wavelength_m: lambda,
             element_size_m: h,
-            divisions: [nr, nt, nz],
+            divisions,
         });
+        sizes.extend(hat_rule);
         materials.push(m);
         body_names.push("disc".to_string());
     }
@@ -184,15 +248,23 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
         let (a, b, yc) = (p.size_x_m, p.size_y_m, p.center_radius_m);
         let face = rule.pin_face_elements as f64;
         let h_pin = a.min(b) / face;
-        let plates: Vec<(&str, &crate::Plate)> = [("thin_plate", &scene.thin_plate), ("thick_plate", &scene.thick_plate)]
-            .into_iter()
-            .filter_map(|(n, p)| p.as_ref().map(|p| (n, p)))
-            .collect();
+        let plates: Vec<(&str, &crate::Plate)> = [
+            ("thin_plate", &scene.thin_plate),
+            ("thick_plate", &scene.thick_plate),
+        ]
+        .into_iter()
+        .filter_map(|(n, p)| p.as_ref().map(|p| (n, p)))
+        .collect();
         let mut plate_mats = Vec::new();
         let mut h_plate = f64::INFINITY;
         for (name, pl) in &plates {
             let m = mat(&pl.material, &format!("{name}.material"))?;
-            let (lambda, h) = element_size(m.as_ref(), pl.thickness_m, rule.max_freq_hz, rule.elements_per_wavelength);
+            let (lambda, h) = element_size(
+                m.as_ref(),
+                pl.thickness_m,
+                rule.max_freq_hz,
+                rule.elements_per_wavelength,
+            );
             h_plate = h_plate.min(h);
             plate_mats.push((m, lambda, h));
         }
@@ -204,8 +276,20 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             yb.extend([yc - pl.width_y_m / 2.0, yc + pl.width_y_m / 2.0]);
         }
         let inside = |lo: f64, hi: f64, c0: f64, c1: f64| lo >= c0 - 1e-12 && hi <= c1 + 1e-12;
-        let xs = graded(&xb, &|lo, hi| if inside(lo, hi, -a / 2.0, a / 2.0) { h_pin } else { h_plate });
-        let ys = graded(&yb, &|lo, hi| if inside(lo, hi, yc - b / 2.0, yc + b / 2.0) { h_pin } else { h_plate });
+        let xs = graded(&xb, &|lo, hi| {
+            if inside(lo, hi, -a / 2.0, a / 2.0) {
+                h_pin
+            } else {
+                h_plate
+            }
+        });
+        let ys = graded(&yb, &|lo, hi| {
+            if inside(lo, hi, yc - b / 2.0, yc + b / 2.0) {
+                h_pin
+            } else {
+                h_plate
+            }
+        });
         let nzp = ((p.height_m / h_pin).ceil() as usize).max(rule.min_layers);
         let pin = Mesh::block(
             &within(&xs, -a / 2.0, a / 2.0),
@@ -227,9 +311,17 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             let nz = ((pl.thickness_m / h).ceil() as usize).max(rule.min_layers);
             let xs_p = within(&xs, -pl.length_x_m / 2.0, pl.length_x_m / 2.0);
             let ys_p = within(&ys, yc - pl.width_y_m / 2.0, yc + pl.width_y_m / 2.0);
-            let block = Mesh::block(&xs_p, &ys_p, &squeal_fe::mesh::linspace(z, z + pl.thickness_m, nz))
-                .with_body(materials.len());
-            let map = mesh.append(&block, &format!("{name}."), Some(1e-9 * (1.0 + pl.length_x_m)));
+            let block = Mesh::block(
+                &xs_p,
+                &ys_p,
+                &squeal_fe::mesh::linspace(z, z + pl.thickness_m, nz),
+            )
+            .with_body(materials.len());
+            let map = mesh.append(
+                &block,
+                &format!("{name}."),
+                Some(1e-9 * (1.0 + pl.length_x_m)),
+            );
             if *name == "thin_plate" {
                 for set in ["xmin", "xmax"] {
                     fixed_nodes.extend(block.node_set(set).unwrap().iter().map(|&n| map[n]));
@@ -254,7 +346,7 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
     let asm = assemble(&mesh, &dofs, &refs).map_err(|source| SceneError::Core {
         file: file.into(),
         context: "assembly".into(),
-        source,
+        source: Box::new(source),
     })?;
     Ok(Model {
         mesh,

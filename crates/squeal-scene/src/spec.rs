@@ -53,19 +53,38 @@ impl MaterialSpec {
     }
 }
 
-/// An annular disc about the z axis, clamped on its inner (hub) cylinder, its top face
-/// (z = 0) the friction face.
+/// An annular disc about the z axis, its top face (z = 0) the friction face. Without a
+/// hat it is clamped on its inner cylinder; with one, at the hat's lower end.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Disc {
-    /// Radius of the clamped hub face (m).
+    /// Inner radius of the disc ring (m): the clamped face when there is no hat.
     pub inner_radius_m: f64,
     /// Outer radius (m).
     pub outer_radius_m: f64,
     /// Thickness (m); the disc spans z in [-thickness, 0].
     pub thickness_m: f64,
-    /// Material.
+    /// Hat joining the ring to the clamp (optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hat: Option<Hat>,
+    /// Material (of ring and hat).
     pub material: MaterialSpec,
+}
+
+/// A hat: a thin cylindrical wall under the disc ring, from `radius_m` (default: the
+/// ring's inner radius) outwards by `thickness_m`, `height_m` deep, clamped at its
+/// lower end. It is the compliant
+/// mounting that sets the rig disc's low rocking and in-plane (ovalling) modes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Hat {
+    /// Inner radius of the wall (m); absent means `disc.inner_radius_m`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius_m: Option<f64>,
+    /// Wall height below the ring (m).
+    pub height_m: f64,
+    /// Wall thickness (m), less than the ring's radial width.
+    pub thickness_m: f64,
 }
 
 /// The pin: a rectangular block standing on the disc's friction face.
@@ -116,7 +135,7 @@ impl Default for MeshRule {
     fn default() -> Self {
         Self {
             max_freq_hz: 10_500.0,
-            elements_per_wavelength: 12.0,
+            elements_per_wavelength: 10.0,
             min_layers: 2,
             pin_face_elements: 10,
         }
@@ -194,13 +213,42 @@ impl Scene {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(field(f, format!("expected a positive length in metres, got {v}")))
+                Err(field(
+                    f,
+                    format!("expected a positive length in metres, got {v}"),
+                ))
             }
         };
         if let Some(d) = &self.disc {
             positive("disc.inner_radius_m", d.inner_radius_m)?;
             positive("disc.outer_radius_m", d.outer_radius_m)?;
             positive("disc.thickness_m", d.thickness_m)?;
+            if let Some(hat) = &d.hat {
+                positive("disc.hat.height_m", hat.height_m)?;
+                positive("disc.hat.thickness_m", hat.thickness_m)?;
+                let r0 = hat.radius_m.unwrap_or(d.inner_radius_m);
+                if r0 < d.inner_radius_m || r0 + hat.thickness_m >= d.outer_radius_m {
+                    return Err(field(
+                        "disc.hat.radius_m",
+                        format!(
+                            "the wall ({r0} to {} m) must lie under the ring ({} to {} m)",
+                            r0 + hat.thickness_m,
+                            d.inner_radius_m,
+                            d.outer_radius_m
+                        ),
+                    ));
+                }
+                if hat.thickness_m >= d.outer_radius_m - d.inner_radius_m {
+                    return Err(field(
+                        "disc.hat.thickness_m",
+                        format!(
+                            "expected less than the ring width {} m, got {}",
+                            d.outer_radius_m - d.inner_radius_m,
+                            hat.thickness_m
+                        ),
+                    ));
+                }
+            }
             if d.inner_radius_m >= d.outer_radius_m {
                 return Err(field(
                     "disc.inner_radius_m",
@@ -217,7 +265,10 @@ impl Scene {
             positive("pin.size_y_m", p.size_y_m)?;
             positive("pin.height_m", p.height_m)?;
             if let Some(d) = &self.disc {
-                let (r0, r1) = (p.center_radius_m - p.size_y_m / 2.0, p.center_radius_m + p.size_y_m / 2.0);
+                let (r0, r1) = (
+                    p.center_radius_m - p.size_y_m / 2.0,
+                    p.center_radius_m + p.size_y_m / 2.0,
+                );
                 let rmax = (r1 * r1 + p.size_x_m * p.size_x_m / 4.0).sqrt();
                 if r0 <= d.inner_radius_m || rmax >= d.outer_radius_m {
                     return Err(field(
@@ -231,7 +282,10 @@ impl Scene {
                 }
             }
         }
-        for (name, plate) in [("thin_plate", &self.thin_plate), ("thick_plate", &self.thick_plate)] {
+        for (name, plate) in [
+            ("thin_plate", &self.thin_plate),
+            ("thick_plate", &self.thick_plate),
+        ] {
             if let Some(pl) = plate {
                 positive(&format!("{name}.length_x_m"), pl.length_x_m)?;
                 positive(&format!("{name}.width_y_m"), pl.width_y_m)?;
@@ -250,23 +304,41 @@ impl Scene {
             }
         }
         if (self.thin_plate.is_some() || self.thick_plate.is_some()) && self.pin.is_none() {
-            return Err(field("pin", "plates are placed over the pin: a [pin] table is required".into()));
+            return Err(field(
+                "pin",
+                "plates are placed over the pin: a [pin] table is required".into(),
+            ));
         }
         if self.thick_plate.is_some() && self.thin_plate.is_none() {
-            return Err(field("thin_plate", "the thick plate sits on the thin plate: a [thin_plate] table is required".into()));
+            return Err(field(
+                "thin_plate",
+                "the thick plate sits on the thin plate: a [thin_plate] table is required".into(),
+            ));
         }
         let m = &self.mesh;
         if !(m.max_freq_hz.is_finite() && m.max_freq_hz > 0.0) {
-            return Err(field("mesh.max_freq_hz", format!("expected a positive frequency in Hz, got {}", m.max_freq_hz)));
+            return Err(field(
+                "mesh.max_freq_hz",
+                format!("expected a positive frequency in Hz, got {}", m.max_freq_hz),
+            ));
         }
         if !(m.elements_per_wavelength.is_finite() && m.elements_per_wavelength >= 2.0) {
-            return Err(field("mesh.elements_per_wavelength", format!("expected a number >= 2, got {}", m.elements_per_wavelength)));
+            return Err(field(
+                "mesh.elements_per_wavelength",
+                format!("expected a number >= 2, got {}", m.elements_per_wavelength),
+            ));
         }
         if m.min_layers == 0 || m.pin_face_elements == 0 {
-            return Err(field("mesh.min_layers", "expected at least 1 layer and 1 pin face element".into()));
+            return Err(field(
+                "mesh.min_layers",
+                "expected at least 1 layer and 1 pin face element".into(),
+            ));
         }
         if self.disc.is_none() && self.pin.is_none() {
-            return Err(field("disc", "a scene needs at least a [disc] or a [pin]".into()));
+            return Err(field(
+                "disc",
+                "a scene needs at least a [disc] or a [pin]".into(),
+            ));
         }
         Ok(())
     }

@@ -16,11 +16,22 @@ fn default_disc_mass_and_clamp() {
     let d = scene.disc.as_ref().unwrap();
     let nt = model.sizes[0].divisions[1] as f64;
     // the mesh is a polygon with nt sides
-    let area = nt / 2.0 * (2.0 * std::f64::consts::PI / nt).sin()
-        * (d.outer_radius_m.powi(2) - d.inner_radius_m.powi(2));
-    approx::assert_relative_eq!(model.total_mass, 7850.0 * area * d.thickness_m, max_relative = 1e-10);
+    let polygon = nt / 2.0 * (2.0 * std::f64::consts::PI / nt).sin();
+    let mut volume =
+        polygon * (d.outer_radius_m.powi(2) - d.inner_radius_m.powi(2)) * d.thickness_m;
+    if let Some(hat) = &d.hat {
+        let r0 = hat.radius_m.unwrap_or(d.inner_radius_m);
+        let r1 = r0 + hat.thickness_m;
+        volume += polygon * (r1.powi(2) - r0.powi(2)) * hat.height_m;
+    }
+    approx::assert_relative_eq!(model.total_mass, 7850.0 * volume, max_relative = 1e-10);
     // hub nodes are eliminated: 3 DOFs per node on the other nodes
-    let hub = model.mesh.node_set("disc.inner").unwrap().len();
+    let clamp = if d.hat.is_some() {
+        "disc.hat.zmin"
+    } else {
+        "disc.inner"
+    };
+    let hub = model.mesh.node_set(clamp).unwrap().len();
     assert_eq!(model.dofs.n_free(), 3 * (model.mesh.n_nodes() - hub));
     assert_eq!(model.k.nrows(), model.dofs.n_free());
 }
@@ -33,24 +44,43 @@ fn pin_stack_is_glued_and_fixed_at_the_plate_ends() {
     let pin_top = model.mesh.node_set("pin.zmax").unwrap();
     let plate_bottom = model.mesh.node_set("thin_plate.zmin").unwrap();
     // every node of the pin's top face is a node of the plate's bottom face
-    assert!(pin_top.iter().all(|n| plate_bottom.binary_search(n).is_ok()));
+    assert!(pin_top
+        .iter()
+        .all(|n| plate_bottom.binary_search(n).is_ok()));
     let ends = model.mesh.node_set("thin_plate.xmin").unwrap();
     for &n in ends {
         assert!(model.dofs.free_of_full[3 * n].is_none());
     }
     let p = scene.pin.as_ref().unwrap();
     let pin_nodes = model.mesh.body_nodes(0);
-    let face = pin_nodes.iter().filter(|&&n| model.mesh.nodes[n][2].abs() < 1e-12).count();
+    let face = pin_nodes
+        .iter()
+        .filter(|&&n| model.mesh.nodes[n][2].abs() < 1e-12)
+        .count();
     let k = scene.mesh.pin_face_elements + 1;
-    assert_eq!(face, k * k, "pin face grid for {} x {} m", p.size_x_m, p.size_y_m);
+    assert_eq!(
+        face,
+        k * k,
+        "pin face grid for {} x {} m",
+        p.size_x_m,
+        p.size_y_m
+    );
 }
 
 #[test]
 fn bad_scenes_name_their_field() {
     let text = Scene::builtin("pin-on-disc").unwrap().to_toml();
     let cases = [
-        ("thickness_m = 0.02", "thickness_m = -0.02", "disc.thickness_m"),
-        ("center_radius_m = 0.1", "center_radius_m = 0.3", "pin.center_radius_m"),
+        (
+            "thickness_m = 0.02",
+            "thickness_m = -0.02",
+            "disc.thickness_m",
+        ),
+        (
+            "center_radius_m = 0.1",
+            "center_radius_m = 0.3",
+            "pin.center_radius_m",
+        ),
         ("[disc]", "[disc]\nwobble = 1", "wobble"),
     ];
     for (from, to, field) in cases {
@@ -60,8 +90,16 @@ fn bad_scenes_name_their_field() {
         assert!(e.contains("bad.toml") && e.contains(field), "{e}");
     }
     let mut s = Scene::builtin("pin-on-disc").unwrap();
-    s.disc.as_mut().unwrap().material.constants.insert("poisson_ratio".into(), toml::Value::Float(0.5));
-    let e = build(&s, BodyKind::Disc, &registry(), "nu.toml").err().unwrap().to_string();
+    s.disc
+        .as_mut()
+        .unwrap()
+        .material
+        .constants
+        .insert("poisson_ratio".into(), toml::Value::Float(0.5));
+    let e = build(&s, BodyKind::Disc, &registry(), "nu.toml")
+        .err()
+        .unwrap()
+        .to_string();
     assert!(e.contains("nu.toml") && e.contains("poisson_ratio"), "{e}");
 }
 
