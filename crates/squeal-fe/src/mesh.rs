@@ -43,16 +43,7 @@ pub fn join(segments: &[Vec<f64>]) -> Vec<f64> {
 
 /// Volume of a trilinear hexahedron (2x2x2 Gauss rule, exact for it).
 pub fn hex_volume(x: &[[f64; 3]; 8]) -> f64 {
-    const S: [[f64; 3]; 8] = [
-        [-1.0, -1.0, -1.0],
-        [1.0, -1.0, -1.0],
-        [1.0, 1.0, -1.0],
-        [-1.0, 1.0, -1.0],
-        [-1.0, -1.0, 1.0],
-        [1.0, -1.0, 1.0],
-        [1.0, 1.0, 1.0],
-        [-1.0, 1.0, 1.0],
-    ];
+    const S: [[f64; 3]; 8] = crate::hex8::NODE_NATURAL;
     let g = 1.0 / 3f64.sqrt();
     let mut vol = 0.0;
     for q in S {
