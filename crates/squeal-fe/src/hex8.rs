@@ -407,19 +407,7 @@ pub fn scaled_jacobian(x: &[[f64; 3]; 8]) -> f64 {
 mod tests {
     use super::*;
 
-    fn iso_d(e: f64, nu: f64) -> Voigt6 {
-        let lam = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
-        let mu = e / (2.0 * (1.0 + nu));
-        let mut d = [[0.0; 6]; 6];
-        for i in 0..3 {
-            for j in 0..3 {
-                d[i][j] = lam;
-            }
-            d[i][i] = lam + 2.0 * mu;
-            d[3 + i][3 + i] = mu;
-        }
-        d
-    }
+    use squeal_materials::isotropic_elasticity as iso_d;
 
     /// A warped, non-affine hexahedron (no parallel faces, non-planar faces).
     fn distorted() -> [[f64; 3]; 8] {
