@@ -7,7 +7,9 @@
 //! the pin along `+e_i`. The static sliding equilibrium solves
 //! `K U = F + (Pn + mu Pt)^T Rn`, `0 <= Rn ⟂ g0 + Pn U >= 0`.
 
-use crate::{Result, SparseMat, SparseRef};
+use crate::linalg::add_scaled;
+use crate::qep::Qep;
+use crate::{Error, Result, SparseMat, SparseRef};
 use faer::Mat;
 
 /// How the normal reaction of a pair relates to its gap.
@@ -85,12 +87,48 @@ pub struct FrictionalOperator {
     pub fc: Option<SparseMat>,
     /// Friction part of the stiffness.
     pub fk: SparseMat,
+    /// The index map `T`: free DOF `j` of the unconstrained model is constrained DOF
+    /// `t[j]` (an eliminated pin-normal DOF points at its disc partner). `None` when the
+    /// operator was given directly (then the operator's DOFs are the full DOFs).
+    pub t: Option<Vec<usize>>,
 }
 
 impl FrictionalOperator {
     /// Size of the constrained problem.
     pub fn dim(&self) -> usize {
         self.kc.nrows()
+    }
+
+    /// Number of DOFs of the unconstrained model (`dim()` when there is no map).
+    pub fn full_dim(&self) -> usize {
+        self.t.as_ref().map_or(self.dim(), |t| t.len())
+    }
+
+    /// The QEP at friction coefficient `mu`: `X~ = X_c - mu F_X`.
+    pub fn at(&self, mu: f64) -> Result<Qep> {
+        if !mu.is_finite() {
+            return Err(Error::param("mu", format!("must be finite, got {mu}")));
+        }
+        let comb = |x: &SparseMat, f: &SparseMat| add_scaled(x.as_ref(), 1.0, f.as_ref(), -mu);
+        let c = match (&self.cc, &self.fc) {
+            (Some(c), Some(f)) => Some(comb(c, f)?),
+            (Some(c), None) => Some(c.clone()),
+            (None, Some(f)) => Some(add_scaled(f.as_ref(), -mu, f.as_ref(), 0.0)?),
+            (None, None) => None,
+        };
+        Ok(Qep {
+            m: comb(&self.mc, &self.fm)?,
+            c,
+            k: comb(&self.kc, &self.fk)?,
+        })
+    }
+
+    /// Expands a constrained vector to the unconstrained DOFs, `u = T u_c`.
+    pub fn expand<T: Copy>(&self, uc: &[T]) -> Vec<T> {
+        match &self.t {
+            Some(t) => t.iter().map(|&j| uc[j]).collect(),
+            None => uc.to_vec(),
+        }
     }
 }
 

@@ -11,6 +11,8 @@
 //! a relative backward error.
 
 use crate::linalg::{norm1, norm2, spmv, ShiftInvert};
+use crate::contact::FrictionalOperator;
+use crate::qep::{ComplexModes, Qep};
 use crate::{Error, Result, SparseRef};
 use faer::Mat;
 use std::time::Instant;
@@ -130,10 +132,8 @@ pub trait SymmetricKernel: Send + Sync {
     ) -> Result<KernelOutput>;
 }
 
-/// The eigen solver plugin trait.
-///
-/// First version: real normal modes. The frictional (non-symmetric quadratic) problem
-/// is added with the frictional operator.
+/// The eigen solver plugin trait: real normal modes of a symmetric pencil and complex
+/// modes of the frictional quadratic eigenproblem.
 pub trait EigenSolver: Send + Sync {
     /// Plugin name (as registered).
     fn name(&self) -> &str;
@@ -143,6 +143,24 @@ pub trait EigenSolver: Send + Sync {
         problem: &SymmetricProblem<'_>,
         params: &EigenParams,
     ) -> Result<RealModes>;
+    /// All complex modes of `qep` with frequency in `[params.fmin_hz, params.fmax_hz]`.
+    fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {
+        let _ = (qep, params);
+        Err(Error::Unsupported {
+            plugin: self.name().to_string(),
+            operation: "the quadratic (frictional) eigenproblem".into(),
+        })
+    }
+    /// The frictional operator at `mu`. The default combines the parts and calls
+    /// [`solve_qep`](Self::solve_qep); a backend may exploit the low-rank friction part.
+    fn solve_frictional(
+        &self,
+        op: &FrictionalOperator,
+        mu: f64,
+        params: &EigenParams,
+    ) -> Result<ComplexModes> {
+        self.solve_qep(&op.at(mu)?, params)
+    }
 }
 
 /// Band driver shared by all symmetric backends: shift-invert below the spectrum,

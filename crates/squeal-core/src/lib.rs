@@ -20,9 +20,11 @@ pub mod error;
 pub mod linalg;
 pub mod material;
 pub mod params;
+pub mod qep;
 pub mod registry;
 
-pub use contact::{ContactLaw, EquilibriumSolver, ReductionBasis};
+pub use contact::{ContactLaw, EquilibriumSolver, FrictionalOperator, ReductionBasis};
+pub use qep::{ComplexKernel, ComplexKernelOutput, ComplexLinOp, ComplexModes, Qep};
 pub use eigen::{
     solve_symmetric_band, EigenParams, EigenSolver, KernelOutput, RealModes, SolveInfo, StopReason,
     SymmetricKernel, SymmetricProblem,
