@@ -92,32 +92,39 @@ pub fn label_disc(mesh: &Mesh, weights: &[f64], nodes: &[usize], u: &[f64]) -> D
         .max_by(|&a, &b| energy[a].total_cmp(&energy[b]))
         .unwrap();
     let kind = ['r', 'c', 'a'][comp];
-    // rings of nodes: same (r, z)
-    let key = |r: f64, z: f64| ((r * 1e7).round() as i64, (z * 1e7).round() as i64);
+    // Rings of nodes: same z, radii binned (the mesh may be graded in theta and blended
+    // into a Cartesian patch under the pin, so radii on a ring are only nearly equal and
+    // angles are not uniform). Fourier coefficients are nodal-weight quadratures of
+    // `v exp(-i n theta)`, normalized per ring.
+    let (rmin, rmax) = cyl.iter().fold((f64::INFINITY, 0.0f64), |(a, b), c| {
+        (a.min(c.0), b.max(c.0))
+    });
+    let dr = ((rmax - rmin) / 24.0).max(1e-9);
+    let key = |r: f64, z: f64| (((r - rmin) / dr).round() as i64, (z * 1e7).round() as i64);
     let mut rings: BTreeMap<(i64, i64), Vec<usize>> = BTreeMap::new();
     for (i, c) in cyl.iter().enumerate() {
         rings.entry(key(c.0, c.2)).or_default().push(i);
     }
+    let ring_weight =
+        |ring: &[usize]| -> f64 { ring.iter().map(|&i| weights[nodes[i]]).sum::<f64>() };
     let nmax = rings.values().map(|v| v.len()).min().unwrap_or(2) / 2;
     let coeff = |ring: &[usize], n: usize, k: usize| -> (f64, f64) {
-        ring.iter().fold((0.0, 0.0), |(re, im), &i| {
+        let (re, im) = ring.iter().fold((0.0, 0.0), |(re, im), &i| {
             let (_, th, _, v) = cyl[i];
+            let w = weights[nodes[i]];
             let a = n as f64 * th;
-            (re + v[k] * a.cos(), im - v[k] * a.sin())
-        })
+            (re + w * v[k] * a.cos(), im - w * v[k] * a.sin())
+        });
+        let tot = ring_weight(ring).max(f64::MIN_POSITIVE);
+        (re / tot, im / tot)
     };
     let mut best = (0usize, -1.0);
     for n in 0..=nmax {
         let mut e = 0.0;
-        for (&(_, _), ring) in &rings {
-            let w = weights[nodes[ring[0]]];
+        for ring in rings.values() {
             let (re, im) = coeff(ring, n, comp);
-            let factor = if n == 0 || 2 * n == ring.len() {
-                1.0
-            } else {
-                2.0
-            };
-            e += w * factor * (re * re + im * im);
+            let factor = if n == 0 { 1.0 } else { 2.0 };
+            e += ring_weight(ring) * factor * (re * re + im * im);
         }
         if e > best.1 {
             best = (n, e);
@@ -136,6 +143,7 @@ pub fn label_disc(mesh: &Mesh, weights: &[f64], nodes: &[usize], u: &[f64]) -> D
         let face: Vec<(f64, (f64, f64))> = rings
             .iter()
             .filter(|((_, z), _)| (*z as f64 * 1e-7 - ztop).abs() < 1e-9 + 1e-6 * ztop.abs())
+            .filter(|(_, ring)| ring.len() > 2 * diameters)
             .map(|(_, ring)| (cyl[ring[0]].0, coeff(ring, diameters, 2)))
             .collect();
         // phase that makes the profile as real as possible: half the angle of sum C^2

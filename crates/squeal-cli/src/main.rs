@@ -1,6 +1,7 @@
 //! The `squeal` command line.
 
 mod modes;
+mod scene_cmd;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -58,6 +59,25 @@ enum Command {
     },
     /// Lists the registered plugins.
     Plugins,
+    /// Scene inspection.
+    Scene {
+        #[command(subcommand)]
+        action: SceneAction,
+    },
+}
+
+#[derive(Subcommand)]
+enum SceneAction {
+    /// DOFs per body, contact pairs, element sizes and quality, and the size rule.
+    Info {
+        /// Scene file (TOML) or embedded scene name; default: `pin-on-disc`.
+        scene: Option<String>,
+    },
+    /// Prints the scene as the program reads it (TOML, every default filled in).
+    Show {
+        /// Scene file (TOML) or embedded scene name; default: `pin-on-disc`.
+        scene: Option<String>,
+    },
 }
 
 /// Loads a scene: a file path, else an embedded name, else the default.
@@ -143,6 +163,16 @@ fn run() -> Result<()> {
                     .with_context(|| format!("writing {}", path.display()))?;
             }
         }
+        Command::Scene { action } => match action {
+            SceneAction::Info { scene } => {
+                let (scene, file) = load_scene(scene.as_deref())?;
+                scene_cmd::info(&registry, &scene, &file)?;
+            }
+            SceneAction::Show { scene } => {
+                let (scene, _) = load_scene(scene.as_deref())?;
+                print!("{}", scene.to_toml());
+            }
+        },
         Command::Plugins => {
             for (kind, list) in [
                 ("material", registry.materials.describe()),

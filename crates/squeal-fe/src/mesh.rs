@@ -41,6 +41,37 @@ pub fn join(segments: &[Vec<f64>]) -> Vec<f64> {
     out
 }
 
+/// Steps that grow geometrically by `ratio` from `h0` up to `h` and then stay at most
+/// `h`, covering exactly `len`: the grading away from a refined zone. The geometric
+/// steps are rescaled when the remainder would be a sliver.
+pub fn graded_steps(len: f64, h0: f64, h: f64, ratio: f64) -> Vec<f64> {
+    if len <= 0.0 {
+        return Vec::new();
+    }
+    let ratio = ratio.max(1.0 + 1e-6);
+    let mut steps = Vec::new();
+    let mut total = 0.0;
+    let mut s = h0;
+    while s * ratio < h {
+        s *= ratio;
+        if total + s > len {
+            break;
+        }
+        steps.push(s);
+        total += s;
+    }
+    let rem = len - total;
+    let last = steps.last().copied().unwrap_or(h0);
+    if rem < 0.5 * last && !steps.is_empty() {
+        let f = len / total;
+        steps.iter_mut().for_each(|x| *x *= f);
+    } else if rem > 0.0 {
+        let n = ((rem / h) - 1e-9).ceil().max(1.0) as usize;
+        steps.extend(std::iter::repeat_n(rem / n as f64, n));
+    }
+    steps
+}
+
 /// Volume of a trilinear hexahedron (2x2x2 Gauss rule, exact for it).
 pub fn hex_volume(x: &[[f64; 3]; 8]) -> f64 {
     const S: [[f64; 3]; 8] = crate::hex8::NODE_NATURAL;
@@ -132,14 +163,30 @@ impl Mesh {
     /// equal sectors (periodic), heights `zs` (increasing), body 0.
     /// Node sets: `inner` (r = `rs[0]`), `outer`, `zmin`, `zmax`.
     pub fn annulus(rs: &[f64], n_theta: usize, zs: &[f64]) -> Mesh {
-        let (nr, nz) = (rs.len(), zs.len());
+        let thetas: Vec<f64> = (0..n_theta)
+            .map(|t| 2.0 * std::f64::consts::PI * t as f64 / n_theta as f64)
+            .collect();
+        Mesh::annulus_mapped(rs, &thetas, zs, &|r, th| [r * th.cos(), r * th.sin()])
+    }
+
+    /// A structured annulus on the polar grid `rs x thetas x zs` whose in-plane node
+    /// positions come from `map(r, theta)` (polar coordinates, or a blend of polar and
+    /// Cartesian as for a contact patch). `thetas` is increasing, spans less than one turn
+    /// and is closed periodically. Node sets as for [`annulus`](Self::annulus).
+    pub fn annulus_mapped(
+        rs: &[f64],
+        thetas: &[f64],
+        zs: &[f64],
+        map: &dyn Fn(f64, f64) -> [f64; 2],
+    ) -> Mesh {
+        let (nr, nz, n_theta) = (rs.len(), zs.len(), thetas.len());
         let id = |i: usize, t: usize, k: usize| (k * n_theta + (t % n_theta)) * nr + i;
         let mut mesh = Mesh::default();
         for &z in zs {
-            for t in 0..n_theta {
-                let th = 2.0 * std::f64::consts::PI * t as f64 / n_theta as f64;
+            for &th in thetas {
                 for &r in rs {
-                    mesh.nodes.push([r * th.cos(), r * th.sin(), z]);
+                    let [x, y] = map(r, th);
+                    mesh.nodes.push([x, y, z]);
                 }
             }
         }

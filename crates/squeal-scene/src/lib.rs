@@ -8,8 +8,10 @@
 mod model;
 mod spec;
 
-pub use model::{build, element_size, BodyKind, Model, SizeRule};
-pub use spec::{Disc, Hat, MaterialSpec, MeshRule, Pin, Plate, Scene};
+pub use model::{build, element_size, BodyKind, BodyStats, ContactGrid, Model, SizeRule};
+pub use spec::{
+    ContactSpec, Disc, Hat, Load, MaterialSpec, MeshRule, Pin, Plate, Scene, Study, Zone,
+};
 
 use thiserror::Error;
 

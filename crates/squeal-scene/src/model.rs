@@ -60,6 +60,206 @@ pub struct Model {
     pub sizes: Vec<SizeRule>,
     /// Build time (s): meshing and assembly.
     pub build_time_s: f64,
+    /// The node-to-node contact pairs between the pin face and the disc, when both are
+    /// built.
+    pub contact: Option<ContactGrid>,
+}
+
+/// Size and quality of one body of a built model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BodyStats {
+    /// Body name.
+    pub body: String,
+    /// Elements.
+    pub elements: usize,
+    /// Nodes (a node glued to an earlier body counts for that body).
+    pub nodes: usize,
+    /// Free DOFs on those nodes.
+    pub dofs: usize,
+    /// Smallest and largest element edge (m).
+    pub edge_range_m: (f64, f64),
+    /// Minimum scaled Jacobian over the body's elements (1 for a cube).
+    pub min_scaled_jacobian: f64,
+}
+
+impl Model {
+    /// Per-body sizes and mesh quality.
+    pub fn body_stats(&self) -> Vec<BodyStats> {
+        let mut owner = vec![usize::MAX; self.mesh.n_nodes()];
+        let mut out: Vec<BodyStats> = self
+            .body_names
+            .iter()
+            .map(|b| BodyStats {
+                body: b.clone(),
+                elements: 0,
+                nodes: 0,
+                dofs: 0,
+                edge_range_m: (f64::INFINITY, 0.0),
+                min_scaled_jacobian: f64::INFINITY,
+            })
+            .collect();
+        for (e, h) in self.mesh.hexes.iter().enumerate() {
+            let b = self.mesh.hex_body[e];
+            let st = &mut out[b];
+            st.elements += 1;
+            let x = self.mesh.hex_coords(e);
+            st.min_scaled_jacobian = st
+                .min_scaled_jacobian
+                .min(squeal_fe::hex8::scaled_jacobian(&x));
+            for (a, c) in [
+                (0, 1),
+                (1, 2),
+                (2, 3),
+                (3, 0),
+                (4, 5),
+                (5, 6),
+                (6, 7),
+                (7, 4),
+                (0, 4),
+                (1, 5),
+                (2, 6),
+                (3, 7),
+            ] {
+                let l = (0..3)
+                    .map(|k| (x[a][k] - x[c][k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                st.edge_range_m = (st.edge_range_m.0.min(l), st.edge_range_m.1.max(l));
+            }
+            for &n in h {
+                if owner[n] == usize::MAX {
+                    owner[n] = b;
+                }
+            }
+        }
+        for (n, &b) in owner.iter().enumerate() {
+            if b != usize::MAX {
+                out[b].nodes += 1;
+                out[b].dofs += (0..3)
+                    .filter(|k| self.dofs.free_of_full[3 * n + k].is_some())
+                    .count();
+            }
+        }
+        out
+    }
+}
+
+/// Compatible node-to-node contact pairs: pin face node and disc node sharing (x, y).
+/// Pair `p = j (nx + 1) + i` sits on grid line `xs[i]` (sliding direction) and `ys[j]`
+/// (radius).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactGrid {
+    /// Pin node of each pair (mesh node index).
+    pub pin_nodes: Vec<usize>,
+    /// Disc node of each pair (mesh node index).
+    pub disc_nodes: Vec<usize>,
+    /// (x, y) of each pair (m), the pin node's.
+    pub xy: Vec<[f64; 2]>,
+    /// Grid indices `[i, j]` of each pair.
+    pub ij: Vec<[usize; 2]>,
+    /// Grid lines along x (m).
+    pub xs: Vec<f64>,
+    /// Grid lines along y (m).
+    pub ys: Vec<f64>,
+    /// Largest in-plane distance between the two nodes of a pair (m).
+    pub max_mismatch_m: f64,
+}
+
+impl ContactGrid {
+    /// Number of pairs.
+    pub fn len(&self) -> usize {
+        self.pin_nodes.len()
+    }
+    /// Whether there is no pair.
+    pub fn is_empty(&self) -> bool {
+        self.pin_nodes.is_empty()
+    }
+}
+
+/// Pairs each pin face node with the disc face node at the same (x, y) to within
+/// `1e-9` of the patch size; an error lists the unmatched nodes.
+fn contact_grid(mesh: &Mesh, pa: &Patch, file: &str) -> Result<ContactGrid> {
+    let size = (pa.xs[pa.xs.len() - 1] - pa.xs[0]).max(pa.ys[pa.ys.len() - 1] - pa.ys[0]);
+    let tol = 1e-9 * size;
+    let pin_face = mesh.node_set("pin.zmin").map_err(|m| SceneError::Field {
+        file: file.into(),
+        field: "pin".into(),
+        message: m,
+    })?;
+    let disc_face = mesh.node_set("disc.zmax").map_err(|m| SceneError::Field {
+        file: file.into(),
+        field: "disc".into(),
+        message: m,
+    })?;
+    let key = |p: &[f64; 3]| {
+        (
+            (p[0] / pa.step).round() as i64,
+            (p[1] / pa.step).round() as i64,
+        )
+    };
+    let mut by_cell: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
+    for &n in disc_face {
+        by_cell.entry(key(&mesh.nodes[n])).or_default().push(n);
+    }
+    let nx = pa.xs.len();
+    let mut grid = ContactGrid {
+        pin_nodes: vec![usize::MAX; nx * pa.ys.len()],
+        disc_nodes: vec![usize::MAX; nx * pa.ys.len()],
+        xy: vec![[0.0; 2]; nx * pa.ys.len()],
+        ij: vec![[0; 2]; nx * pa.ys.len()],
+        xs: pa.xs.clone(),
+        ys: pa.ys.clone(),
+        max_mismatch_m: 0.0,
+    };
+    let mut unmatched = Vec::new();
+    for &n in pin_face {
+        let p = mesh.nodes[n];
+        let i = pa.xs.iter().position(|&x| (x - p[0]).abs() <= tol);
+        let j = pa.ys.iter().position(|&y| (y - p[1]).abs() <= tol);
+        let (k0, k1) = key(&p);
+        let mut best: Option<(f64, usize)> = None;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for &m in by_cell.get(&(k0 + dx, k1 + dy)).into_iter().flatten() {
+                    let q = mesh.nodes[m];
+                    let d = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt();
+                    if best.is_none_or(|b| d < b.0) {
+                        best = Some((d, m));
+                    }
+                }
+            }
+        }
+        match (i, j, best) {
+            (Some(i), Some(j), Some((d, m))) if d <= tol => {
+                let k = j * nx + i;
+                grid.pin_nodes[k] = n;
+                grid.disc_nodes[k] = m;
+                grid.xy[k] = [p[0], p[1]];
+                grid.ij[k] = [i, j];
+                grid.max_mismatch_m = grid.max_mismatch_m.max(d);
+            }
+            _ => unmatched.push(format!("node {n} at ({:.6e}, {:.6e}) m", p[0], p[1])),
+        }
+    }
+    if !unmatched.is_empty() || grid.pin_nodes.contains(&usize::MAX) {
+        let shown: Vec<String> = unmatched.iter().take(8).cloned().collect();
+        return Err(SceneError::Field {
+            file: file.into(),
+            field: "pin".into(),
+            message: format!(
+                "incompatible contact meshes: {} pin face nodes have no disc node within \
+                 {tol:.1e} m in (x, y){}{}",
+                unmatched.len(),
+                if shown.is_empty() {
+                    String::new()
+                } else {
+                    format!(": {}", shown.join("; "))
+                },
+                if unmatched.len() > 8 { " ..." } else { "" }
+            ),
+        });
+    }
+    Ok(grid)
 }
 
 /// Bending-wave element size for a plate of `thickness` made of `mat` at `freq_hz`.
@@ -137,6 +337,123 @@ fn within(v: &[f64], lo: f64, hi: f64) -> Vec<f64> {
         .collect()
 }
 
+/// The contact patch: the pin face's Cartesian grid `xs x ys` (sliding direction x,
+/// radius y), which the disc mesh reproduces exactly under the pin.
+struct Patch {
+    /// Grid lines along x (m), increasing.
+    xs: Vec<f64>,
+    /// Grid lines along y (m), increasing.
+    ys: Vec<f64>,
+    /// Centre radius (m).
+    yc: f64,
+    /// Grid step (m).
+    step: f64,
+}
+
+impl Patch {
+    fn new(p: &crate::Pin, n: usize) -> Self {
+        let (a, b, yc) = (p.size_x_m, p.size_y_m, p.center_radius_m);
+        Patch {
+            xs: squeal_fe::mesh::linspace(-a / 2.0, a / 2.0, n),
+            ys: squeal_fe::mesh::linspace(yc - b / 2.0, yc + b / 2.0, n),
+            yc,
+            step: a.min(b) / n as f64,
+        }
+    }
+
+    /// Half the angle the patch spans at its centre radius.
+    fn half_angle(&self) -> f64 {
+        self.xs[self.xs.len() - 1] / self.yc
+    }
+
+    /// Angular grid: the patch lines at `theta = pi/2 - x/yc`, graded by `ratio` up to
+    /// `dtheta` around the rest of the turn. Increasing, less than one turn.
+    fn thetas(&self, dtheta: f64, ratio: f64) -> Vec<f64> {
+        let c = std::f64::consts::FRAC_PI_2;
+        let mut th: Vec<f64> = self.xs.iter().rev().map(|x| c - x / self.yc).collect();
+        let span = 2.0 * std::f64::consts::PI - 2.0 * self.half_angle();
+        let half = squeal_fe::mesh::graded_steps(span / 2.0, self.step / self.yc, dtheta, ratio);
+        let mut steps = half.clone();
+        steps.extend(half.iter().rev());
+        let mut t = th[th.len() - 1];
+        for st in &steps[..steps.len() - 1] {
+            t += st;
+            th.push(t);
+        }
+        th
+    }
+
+    /// The in-plane map: Cartesian `(-yc phi, r)` on the patch (`phi = theta - pi/2`),
+    /// polar far from it, a smooth blend over one patch size around it that vanishes
+    /// before the hat wall and the outer edge (which stays a true circle).
+    fn blend(&self, r_wall: f64, r_out: f64) -> Blend {
+        let (r0, r1) = (self.ys[0], self.ys[self.ys.len() - 1]);
+        let b = r1 - r0;
+        Blend {
+            r0,
+            r1,
+            yc: self.yc,
+            half: self.half_angle(),
+            dr_in: b.min(0.8 * (r0 - r_wall)),
+            dr_out: b.min(0.8 * (r_out - r1)),
+            dphi: (2.0 * self.half_angle()).min(0.5 * (std::f64::consts::PI - self.half_angle())),
+        }
+    }
+}
+
+/// See [`Patch::blend`].
+struct Blend {
+    r0: f64,
+    r1: f64,
+    yc: f64,
+    half: f64,
+    dr_in: f64,
+    dr_out: f64,
+    dphi: f64,
+}
+
+impl Blend {
+    fn map(&self, r: f64, th: f64) -> [f64; 2] {
+        let polar = [r * th.cos(), r * th.sin()];
+        let mut phi = th - std::f64::consts::FRAC_PI_2;
+        while phi > std::f64::consts::PI {
+            phi -= 2.0 * std::f64::consts::PI;
+        }
+        while phi <= -std::f64::consts::PI {
+            phi += 2.0 * std::f64::consts::PI;
+        }
+        let tr = if r < self.r0 {
+            (self.r0 - r) / self.dr_in
+        } else if r > self.r1 {
+            (r - self.r1) / self.dr_out
+        } else {
+            0.0
+        };
+        let tp = ((phi.abs() - self.half) / self.dphi).max(0.0);
+        // smooth step: 1 at t <= 0, 0 at t >= 1, zero slope at both ends
+        let step = |t: f64| {
+            if t <= 1e-12 {
+                1.0
+            } else if t >= 1.0 {
+                0.0
+            } else {
+                1.0 - t * t * (3.0 - 2.0 * t)
+            }
+        };
+        let w = step(tr) * step(tp);
+        if w == 1.0 {
+            [-self.yc * phi, r]
+        } else if w == 0.0 {
+            polar
+        } else {
+            [
+                w * (-self.yc * phi) + (1.0 - w) * polar[0],
+                w * r + (1.0 - w) * polar[1],
+            ]
+        }
+    }
+}
+
 /// Builds the bodies of `scene` selected by `which`, with materials from `registry`;
 /// `file` names the scene in errors.
 pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) -> Result<Model> {
@@ -163,6 +480,11 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
     let mut body_names = Vec::new();
     let mut sizes = Vec::new();
     let mut fixed_nodes: Vec<usize> = Vec::new();
+    // The contact patch under the pin: a Cartesian grid blended into the polar disc.
+    let patch = scene
+        .pin
+        .as_ref()
+        .map(|p| Patch::new(p, rule.pin_face_elements));
 
     if matches!(which, BodyKind::Disc | BodyKind::All) {
         let d = scene.disc.as_ref().ok_or_else(|| missing("disc"))?;
@@ -188,7 +510,7 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             );
             (lw, hw, hat.thickness_m / rule.min_layers as f64)
         });
-        let mut rb = vec![d.inner_radius_m, d.outer_radius_m];
+        let mut rb = vec![d.inner_radius_m];
         let r_in_wall = d
             .hat
             .as_ref()
@@ -201,11 +523,64 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
         if d.hat.is_some() {
             rb.extend([r_in_wall, r_wall]);
         }
-        let rs = graded(&rb, &|lo, hi| match wall {
+        let size = |lo: f64, hi: f64| match wall {
             Some((_, _, t)) if lo >= r_in_wall - 1e-12 && hi <= r_wall + 1e-12 => t,
             _ => h,
-        });
-        let ring = Mesh::annulus(&rs, nt, &zs).with_body(body);
+        };
+        let q = rule.grading_ratio;
+        let (rs, thetas) = match &patch {
+            None => {
+                rb.push(d.outer_radius_m);
+                let thetas: Vec<f64> = (0..nt)
+                    .map(|t| 2.0 * std::f64::consts::PI * t as f64 / nt as f64)
+                    .collect();
+                (graded(&rb, &size), thetas)
+            }
+            Some(pa) => {
+                let mut rs = if rb.len() > 1 {
+                    graded(&rb, &size)
+                } else {
+                    rb.clone()
+                };
+                let r_a = *rs.last().unwrap();
+                let down = squeal_fe::mesh::graded_steps(pa.ys[0] - r_a, pa.step, h, q);
+                let mut r = pa.ys[0];
+                let mut inward: Vec<f64> = down
+                    .iter()
+                    .take(down.len().saturating_sub(1))
+                    .map(|st| {
+                        r -= st;
+                        r
+                    })
+                    .collect();
+                inward.reverse();
+                rs.extend(inward);
+                rs.extend(&pa.ys);
+                let up = squeal_fe::mesh::graded_steps(
+                    d.outer_radius_m - pa.ys[pa.ys.len() - 1],
+                    pa.step,
+                    h,
+                    q,
+                );
+                let mut r = pa.ys[pa.ys.len() - 1];
+                for (i, st) in up.iter().enumerate() {
+                    r = if i + 1 == up.len() {
+                        d.outer_radius_m
+                    } else {
+                        r + st
+                    };
+                    rs.push(r);
+                }
+                (rs, pa.thetas(2.0 * std::f64::consts::PI / nt as f64, q))
+            }
+        };
+        let blend = patch.as_ref().map(|pa| pa.blend(r_wall, d.outer_radius_m));
+        let xy_map = |r: f64, th: f64| match &blend {
+            Some(b) => b.map(r, th),
+            None => [r * th.cos(), r * th.sin()],
+        };
+        let nt = thetas.len();
+        let ring = Mesh::annulus_mapped(&rs, &thetas, &zs, &xy_map).with_body(body);
         let map = mesh.append(&ring, "disc.", None);
         let mut divisions = [rs.len() - 1, nt, zs.len() - 1];
         let mut hat_rule = None;
@@ -213,10 +588,11 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             (Some(hat), Some((lw, hw, _))) => {
                 let nzh = ((hat.height_m / hw.min(h)).ceil() as usize).max(rule.min_layers);
                 let wall_rs = within(&rs, r_in_wall, r_wall);
-                let hat_mesh = Mesh::annulus(
+                let hat_mesh = Mesh::annulus_mapped(
                     &wall_rs,
-                    nt,
+                    &thetas,
                     &squeal_fe::mesh::linspace(-d.thickness_m - hat.height_m, -d.thickness_m, nzh),
+                    &xy_map,
                 )
                 .with_body(body);
                 let hmap = mesh.append(&hat_mesh, "disc.hat.", Some(1e-9 * d.outer_radius_m));
@@ -268,35 +644,60 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             h_plate = h_plate.min(h);
             plate_mats.push((m, lambda, h));
         }
-        // common grid lines in x and y: pin face finely, plates at their own size
-        let mut xb = vec![-a / 2.0, a / 2.0];
-        let mut yb = vec![yc - b / 2.0, yc + b / 2.0];
-        for (_, pl) in &plates {
-            xb.extend([-pl.length_x_m / 2.0, pl.length_x_m / 2.0]);
-            yb.extend([yc - pl.width_y_m / 2.0, yc + pl.width_y_m / 2.0]);
+        let pa = patch.as_ref().expect("a pin has a patch");
+        // common grid lines in x and y: the pin face's contact grid, plates graded away
+        // from it; the plates' grids contain the pin's, so glued faces conform
+        let (lx, ly) = plates.iter().fold((a, b), |(lx, ly), (_, pl)| {
+            (lx.max(pl.length_x_m), ly.max(pl.width_y_m))
+        });
+        let around = |grid: &[f64], lo: f64, hi: f64| -> Vec<f64> {
+            let mut v: Vec<f64> = Vec::new();
+            let mut x = grid[0];
+            for st in
+                squeal_fe::mesh::graded_steps(grid[0] - lo, pa.step, h_plate, rule.grading_ratio)
+            {
+                x -= st;
+                v.push(x);
+            }
+            if let Some(last) = v.last_mut() {
+                *last = lo;
+            }
+            v.reverse();
+            v.extend_from_slice(grid);
+            let mut x = grid[grid.len() - 1];
+            let up = squeal_fe::mesh::graded_steps(hi - x, pa.step, h_plate, rule.grading_ratio);
+            for (i, st) in up.iter().enumerate() {
+                x = if i + 1 == up.len() { hi } else { x + st };
+                v.push(x);
+            }
+            v
+        };
+        let xs = around(&pa.xs, -lx / 2.0, lx / 2.0);
+        let ys = around(&pa.ys, yc - ly / 2.0, yc + ly / 2.0);
+        // through the pin height: the face step at the contact, graded up to the size the
+        // band needs in the pad material
+        let (_, h_pin_z) = element_size(
+            pin_mat.as_ref(),
+            a.min(b),
+            rule.max_freq_hz,
+            rule.elements_per_wavelength,
+        );
+        let h_pin_z = h_pin_z.min(p.height_m / rule.min_layers as f64).max(h_pin);
+        let mut zp = vec![0.0];
+        let z_steps =
+            squeal_fe::mesh::graded_steps(p.height_m - h_pin, h_pin, h_pin_z, rule.grading_ratio);
+        zp.push(h_pin.min(p.height_m));
+        let mut z = zp[1];
+        for (i, st) in z_steps.iter().enumerate() {
+            z = if i + 1 == z_steps.len() {
+                p.height_m
+            } else {
+                z + st
+            };
+            zp.push(z);
         }
-        let inside = |lo: f64, hi: f64, c0: f64, c1: f64| lo >= c0 - 1e-12 && hi <= c1 + 1e-12;
-        let xs = graded(&xb, &|lo, hi| {
-            if inside(lo, hi, -a / 2.0, a / 2.0) {
-                h_pin
-            } else {
-                h_plate
-            }
-        });
-        let ys = graded(&yb, &|lo, hi| {
-            if inside(lo, hi, yc - b / 2.0, yc + b / 2.0) {
-                h_pin
-            } else {
-                h_plate
-            }
-        });
-        let nzp = ((p.height_m / h_pin).ceil() as usize).max(rule.min_layers);
-        let pin = Mesh::block(
-            &within(&xs, -a / 2.0, a / 2.0),
-            &within(&ys, yc - b / 2.0, yc + b / 2.0),
-            &squeal_fe::mesh::linspace(0.0, p.height_m, nzp),
-        )
-        .with_body(materials.len());
+        let nzp = zp.len() - 1;
+        let pin = Mesh::block(&pa.xs, &pa.ys, &zp).with_body(materials.len());
         mesh.append(&pin, "pin.", None);
         sizes.push(SizeRule {
             body: "pin".into(),
@@ -339,6 +740,10 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
         }
     }
 
+    let contact = match (&patch, which) {
+        (Some(pa), BodyKind::All) if scene.disc.is_some() => Some(contact_grid(&mesh, pa, file)?),
+        _ => None,
+    };
     fixed_nodes.sort_unstable();
     fixed_nodes.dedup();
     let dofs = DofMap::new(&mesh, &DofMap::node_dofs(&fixed_nodes));
@@ -357,6 +762,7 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
         total_mass: asm.total_mass,
         sizes,
         build_time_s: start.elapsed().as_secs_f64(),
+        contact,
     })
 }
 

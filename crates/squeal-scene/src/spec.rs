@@ -127,8 +127,11 @@ pub struct MeshRule {
     pub elements_per_wavelength: f64,
     /// Minimum element layers through any thickness.
     pub min_layers: usize,
-    /// Elements along each side of the pin face.
+    /// Elements along each side of the pin face (the contact grid has
+    /// `(pin_face_elements + 1)^2` pairs).
     pub pin_face_elements: usize,
+    /// Growth ratio of consecutive element sizes away from the refined contact patch.
+    pub grading_ratio: f64,
 }
 
 impl Default for MeshRule {
@@ -137,7 +140,8 @@ impl Default for MeshRule {
             max_freq_hz: 10_500.0,
             elements_per_wavelength: 10.0,
             min_layers: 2,
-            pin_face_elements: 10,
+            pin_face_elements: 20,
+            grading_ratio: 1.5,
         }
     }
 }
@@ -162,6 +166,89 @@ pub struct Scene {
     /// Mesh rule.
     #[serde(default)]
     pub mesh: MeshRule,
+    /// Contact between the pin face and the disc.
+    #[serde(default)]
+    pub contact: ContactSpec,
+    /// The load pressing the disc against the pin.
+    #[serde(default)]
+    pub load: Load,
+    /// Friction coefficient and frequency band of the study.
+    #[serde(default)]
+    pub study: Study,
+}
+
+/// Which contact pairs may carry load (the effective zone is then decided by the
+/// equilibrium within them).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, tag = "kind", rename_all = "snake_case")]
+pub enum Zone {
+    /// Every pair of the pin face.
+    #[default]
+    Uniform,
+    /// Pairs inside the rectangle `[x0, x0 + a] x [y0, y0 + b]`, coordinates relative to
+    /// the pin face's corner at (-size_x/2, center_radius - size_y/2) (m).
+    Rectangle {
+        /// Start along x (sliding direction) (m).
+        x0_m: f64,
+        /// Start along y (radius) (m).
+        y0_m: f64,
+        /// Length along x (m).
+        a_m: f64,
+        /// Width along y (m).
+        b_m: f64,
+    },
+}
+
+/// Contact between the pin face and the disc.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct ContactSpec {
+    /// Pairs allowed to touch.
+    pub zone: Zone,
+}
+
+/// The load: a target total normal force, or an imposed axial displacement of the disc
+/// towards the pin (exactly one of the two).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Load {
+    /// Target total normal force (N).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal_force_n: Option<f64>,
+    /// Imposed axial displacement of the disc's clamped face towards the pin (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub disc_displacement_m: Option<f64>,
+}
+
+impl Default for Load {
+    fn default() -> Self {
+        Self {
+            normal_force_n: Some(200.0),
+            disc_displacement_m: None,
+        }
+    }
+}
+
+/// Friction and band of the study.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Study {
+    /// Coulomb friction coefficient.
+    pub mu: f64,
+    /// Frequency band of the stability analysis (Hz).
+    pub band_hz: [f64; 2],
+    /// Rotation sense of the disc about +z: `1` counter-clockwise, `-1` clockwise.
+    pub rotation: f64,
+}
+
+impl Default for Study {
+    fn default() -> Self {
+        Self {
+            mu: 0.3,
+            band_hz: [0.0, 10_000.0],
+            rotation: 1.0,
+        }
+    }
 }
 
 impl Scene {
@@ -270,13 +357,17 @@ impl Scene {
                     p.center_radius_m + p.size_y_m / 2.0,
                 );
                 let rmax = (r1 * r1 + p.size_x_m * p.size_x_m / 4.0).sqrt();
-                if r0 <= d.inner_radius_m || rmax >= d.outer_radius_m {
+                let wall = d.hat.as_ref().map_or(d.inner_radius_m, |h| {
+                    h.radius_m.unwrap_or(d.inner_radius_m) + h.thickness_m
+                });
+                if r0 <= wall || rmax >= d.outer_radius_m {
                     return Err(field(
                         "pin.center_radius_m",
                         format!(
                             "the pin face (radii {r0:.4} to {rmax:.4} m) must lie on the disc face \
-                             between disc.inner_radius_m = {} and disc.outer_radius_m = {}",
-                            d.inner_radius_m, d.outer_radius_m
+                             between radius {wall} (inner radius or hat wall) and \
+                             disc.outer_radius_m = {}",
+                            d.outer_radius_m
                         ),
                     ));
                 }
@@ -333,6 +424,89 @@ impl Scene {
                 "mesh.min_layers",
                 "expected at least 1 layer and 1 pin face element".into(),
             ));
+        }
+        if !(m.grading_ratio.is_finite() && (1.0..=3.0).contains(&m.grading_ratio)) {
+            return Err(field(
+                "mesh.grading_ratio",
+                format!("expected a ratio in [1, 3], got {}", m.grading_ratio),
+            ));
+        }
+        match (self.load.normal_force_n, self.load.disc_displacement_m) {
+            (Some(f), None) if f.is_finite() && f > 0.0 => {}
+            (None, Some(d)) if d.is_finite() && d > 0.0 => {}
+            (Some(f), None) => {
+                return Err(field(
+                    "load.normal_force_n",
+                    format!("expected a positive force in N, got {f}"),
+                ))
+            }
+            (None, Some(d)) => {
+                return Err(field(
+                    "load.disc_displacement_m",
+                    format!("expected a positive displacement in m towards the pin, got {d}"),
+                ))
+            }
+            _ => {
+                return Err(field(
+                    "load",
+                    "give exactly one of normal_force_n and disc_displacement_m".into(),
+                ))
+            }
+        }
+        let st = &self.study;
+        if !(st.mu.is_finite() && st.mu >= 0.0) {
+            return Err(field(
+                "study.mu",
+                format!("expected a friction coefficient >= 0, got {}", st.mu),
+            ));
+        }
+        if !(st.band_hz[0].is_finite()
+            && st.band_hz[1].is_finite()
+            && st.band_hz[0] >= 0.0
+            && st.band_hz[0] < st.band_hz[1])
+        {
+            return Err(field(
+                "study.band_hz",
+                format!(
+                    "expected [fmin, fmax] in Hz with 0 <= fmin < fmax, got {:?}",
+                    st.band_hz
+                ),
+            ));
+        }
+        if st.rotation != 1.0 && st.rotation != -1.0 {
+            return Err(field(
+                "study.rotation",
+                format!(
+                    "expected 1 (counter-clockwise about +z) or -1, got {}",
+                    st.rotation
+                ),
+            ));
+        }
+        if let (
+            Zone::Rectangle {
+                x0_m,
+                y0_m,
+                a_m,
+                b_m,
+            },
+            Some(p),
+        ) = (&self.contact.zone, &self.pin)
+        {
+            let ok = [*x0_m, *y0_m].iter().all(|v| v.is_finite() && *v >= 0.0)
+                && *a_m > 0.0
+                && *b_m > 0.0
+                && x0_m + a_m <= p.size_x_m * (1.0 + 1e-9)
+                && y0_m + b_m <= p.size_y_m * (1.0 + 1e-9);
+            if !ok {
+                return Err(field(
+                    "contact.zone",
+                    format!(
+                        "rectangle x0_m = {x0_m}, y0_m = {y0_m}, a_m = {a_m}, b_m = {b_m} must \
+                         have a, b > 0 and lie inside the pin face ({} x {} m)",
+                        p.size_x_m, p.size_y_m
+                    ),
+                ));
+            }
         }
         if self.disc.is_none() && self.pin.is_none() {
             return Err(field(

@@ -1,0 +1,74 @@
+//! `squeal scene info`: what the builder makes of a scene and why.
+
+use anyhow::Result;
+use squeal_core::Registry;
+use squeal_scene::{build, BodyKind, Scene};
+
+/// Builds the whole scene and prints DOFs per body, contact pairs, element sizes, mesh
+/// quality and the rule that chose the sizes.
+pub fn info(registry: &Registry, scene: &Scene, file: &str) -> Result<()> {
+    let model = build(scene, BodyKind::All, registry, file)?;
+    let r = &scene.mesh;
+    println!("scene `{}` ({file})", scene.name);
+    println!(
+        "rule: element edge <= bending wavelength at {} Hz / {}, >= {} layers per thickness, \
+         pin face {} x {} elements, grading ratio {} away from the contact patch",
+        r.max_freq_hz,
+        r.elements_per_wavelength,
+        r.min_layers,
+        r.pin_face_elements,
+        r.pin_face_elements,
+        r.grading_ratio
+    );
+    println!(
+        "model: {} free DOFs, {} elements, {} nodes, {:.3} kg, built in {:.2} s",
+        model.dofs.full_of_free.len(),
+        model.mesh.hexes.len(),
+        model.mesh.n_nodes(),
+        model.total_mass,
+        model.build_time_s
+    );
+    println!(
+        "\n{:<12} {:>8} {:>8} {:>8}  {:>18}  {:>10}",
+        "body", "elements", "nodes", "DOFs", "edges (mm)", "min sJ"
+    );
+    for b in model.body_stats() {
+        println!(
+            "{:<12} {:>8} {:>8} {:>8}  {:>8.3} - {:<7.3}  {:>10.3}",
+            b.body,
+            b.elements,
+            b.nodes,
+            b.dofs,
+            b.edge_range_m.0 * 1e3,
+            b.edge_range_m.1 * 1e3,
+            b.min_scaled_jacobian
+        );
+    }
+    println!("\nsize rule per body:");
+    for s in &model.sizes {
+        let wl = if s.wavelength_m.is_finite() {
+            format!("{:.1} mm", s.wavelength_m * 1e3)
+        } else {
+            "-".into()
+        };
+        println!(
+            "  {:<12} bending wavelength {:>9}, target edge {:.2} mm, divisions {:?}",
+            s.body,
+            wl,
+            s.element_size_m * 1e3,
+            s.divisions
+        );
+    }
+    match &model.contact {
+        Some(c) => println!(
+            "\ncontact: {} node-to-node pairs ({} x {} grid, step {:.3} mm), max (x, y) mismatch {:.1e} m",
+            c.len(),
+            c.xs.len(),
+            c.ys.len(),
+            (c.xs[1] - c.xs[0]) * 1e3,
+            c.max_mismatch_m
+        ),
+        None => println!("\ncontact: none (the scene needs a disc and a pin)"),
+    }
+    Ok(())
+}
