@@ -5,6 +5,7 @@
 //! crate under `plugins/` plus one `register` line in [`registry`].
 
 pub use squeal_analysis as analysis;
+pub use squeal_contact as contact;
 pub use squeal_core as core;
 pub use squeal_core::Registry;
 pub use squeal_fe as fe;
@@ -14,6 +15,9 @@ pub use squeal_scene as scene;
 pub fn registry() -> Registry {
     let mut reg = Registry::new();
     squeal_materials::register(&mut reg);
+    squeal_contact_laws::register(&mut reg);
+    squeal_equilibrium_lorang::register(&mut reg);
+    squeal_equilibrium_lcp::register(&mut reg);
     squeal_eigen_arpack::register(&mut reg);
     squeal_eigen_krylov::register(&mut reg);
     reg

@@ -1,5 +1,6 @@
 //! The `squeal` command line.
 
+mod equilibrium;
 mod modes;
 mod scene_cmd;
 
@@ -56,6 +57,28 @@ enum Command {
         /// Write the report JSON here.
         #[arg(long)]
         json: Option<std::path::PathBuf>,
+    },
+    /// The steady sliding equilibrium (unilateral contact, Coulomb friction) for one or
+    /// several mu: equilibrium.json (one object, or a list for several mu), per-pair CSV
+    /// and a contact force map.
+    Equilibrium {
+        /// Scene file (TOML) or embedded scene name; default: `pin-on-disc`.
+        scene: Option<String>,
+        /// Friction coefficient(s), comma separated (default: the scene's study.mu).
+        #[arg(long, value_delimiter = ',')]
+        mu: Vec<f64>,
+        /// Equilibrium solver plugin (`lorang`, `lcp`).
+        #[arg(long, default_value = "lcp")]
+        solver: String,
+        /// Contact law plugin (`lagrange`, `penalty`).
+        #[arg(long, default_value = "lagrange")]
+        law: String,
+        /// Contact law parameters, `key=value` (e.g. `kn_n_per_m=1e10`).
+        #[arg(long = "law-opt")]
+        law_opt: Vec<String>,
+        /// Output directory.
+        #[arg(long, default_value = "out/equilibrium")]
+        out: std::path::PathBuf,
     },
     /// Lists the registered plugins.
     Plugins,
@@ -173,6 +196,66 @@ fn run() -> Result<()> {
                 print!("{}", scene.to_toml());
             }
         },
+        Command::Equilibrium {
+            scene,
+            mu,
+            solver,
+            law,
+            law_opt,
+            out,
+        } => {
+            let mut law_params = squeal_core::Params::new();
+            for kv in &law_opt {
+                let (k, v) = squeal_core::Params::parse_kv(kv)?;
+                law_params.0.insert(k, v);
+            }
+            let mus = if mu.is_empty() {
+                vec![load_scene(scene.as_deref())?.0.study.mu]
+            } else {
+                mu
+            };
+            let reports = equilibrium::run(
+                &registry,
+                scene.as_deref(),
+                &mus,
+                &solver,
+                &law,
+                &law_params,
+                &out,
+            )?;
+            println!(
+                "{:>6} {:>10} {:>10} {:>7} {:>6} {:>10} {:>10} {:>13} {:>8}",
+                "mu",
+                "Fn (N)",
+                "Ft (N)",
+                "active",
+                "iter",
+                "residual",
+                "compl.",
+                "centroid x mm",
+                "time s"
+            );
+            for r in &reports {
+                println!(
+                    "{:>6.3} {:>10.4} {:>10.4} {:>7} {:>6} {:>10.2e} {:>10.2e} {:>13.4} {:>8.3}",
+                    r.mu,
+                    r.total_normal_force_n,
+                    r.total_tangential_force_n,
+                    r.active_pairs,
+                    r.iterations,
+                    r.residual,
+                    r.complementarity_residual,
+                    r.centroid_m[0] * 1e3,
+                    r.time_s
+                );
+            }
+            if let Some(r) = reports.first() {
+                println!("leading edge {}", r.leading_edge);
+            }
+            for p in equilibrium::outputs(&out, &reports) {
+                println!("wrote {}", p.display());
+            }
+        }
         Command::Plugins => {
             for (kind, list) in [
                 ("material", registry.materials.describe()),

@@ -7,10 +7,12 @@
 //! the pin along `+e_i`. The static sliding equilibrium solves
 //! `K U = F + (Pn + mu Pt)^T Rn`, `0 <= Rn ⟂ g0 + Pn U >= 0`.
 
-use crate::linalg::add_scaled;
+use crate::linalg::{add_scaled, norm2, spmv, Cholesky};
 use crate::qep::Qep;
 use crate::{Error, Result, SparseMat, SparseRef};
+use faer::sparse::Triplet;
 use faer::Mat;
+use faer::MatRef;
 
 /// How the normal reaction of a pair relates to its gap.
 pub trait ContactLaw: Send + Sync {
@@ -19,6 +21,11 @@ pub trait ContactLaw: Send + Sync {
     /// Normal stiffness per pair (N/m) of a penalty law; `None` for the exact
     /// unilateral (Signorini) constraint.
     fn normal_stiffness(&self) -> Option<f64>;
+    /// Normal compliance per pair (m/N) that the law adds to the contact flexibility:
+    /// a closed pair satisfies `g + compliance * Rn = 0` instead of `g = 0`.
+    fn compliance(&self) -> f64 {
+        self.normal_stiffness().map_or(0.0, |k| 1.0 / k)
+    }
 }
 
 /// The static contact problem on the free DOFs.
@@ -49,7 +56,10 @@ pub struct Equilibrium {
     pub active: Vec<bool>,
     /// Outer iterations.
     pub iterations: usize,
-    /// `||K U - F - (Pn + mu Pt)^T Rn|| / ||F||`.
+    /// Sparse factorizations of `K` performed.
+    pub factorizations: usize,
+    /// Backward error of the global equilibrium,
+    /// `||K U - F - (Pn + mu Pt)^T Rn|| / (||K||_1 ||U|| + ||F + (Pn + mu Pt)^T Rn||)`.
     pub equilibrium_residual: f64,
     /// Complementarity residual, relative to the total normal force.
     pub complementarity_residual: f64,
@@ -58,16 +68,35 @@ pub struct Equilibrium {
 }
 
 /// Computes the steady full-sliding equilibrium.
+///
+/// A solver works on the problem condensed on the contact pairs ([`Condensation`]), so
+/// that a sweep over mu factorizes `K` once; [`solve`](Self::solve) condenses and solves.
 pub trait EquilibriumSolver: Send + Sync {
     /// Plugin name (as registered).
     fn name(&self) -> &str;
-    /// Solves the problem for friction coefficient `mu` under the given law.
+    /// Solves for friction coefficient `mu` under the given law, on a condensation of
+    /// `problem`.
+    fn solve_condensed(
+        &self,
+        cond: &Condensation,
+        problem: &ContactProblem<'_>,
+        law: &dyn ContactLaw,
+        mu: f64,
+    ) -> Result<Equilibrium>;
+    /// Condenses `problem` (one factorization of `K`) and solves it.
     fn solve(
         &self,
         problem: &ContactProblem<'_>,
         law: &dyn ContactLaw,
         mu: f64,
-    ) -> Result<Equilibrium>;
+    ) -> Result<Equilibrium> {
+        let start = std::time::Instant::now();
+        check_mu(mu)?;
+        let cond = Condensation::new(problem)?;
+        let mut eq = self.solve_condensed(&cond, problem, law, mu)?;
+        eq.time_s = start.elapsed().as_secs_f64();
+        Ok(eq)
+    }
 }
 
 /// The constrained frictional operator of one contact set: the mu-independent parts
@@ -152,4 +181,342 @@ pub trait ReductionBasis: Send + Sync {
     /// Builds the basis for friction coefficient `mu` and band `(fmin, fmax)` in Hz;
     /// bases fixed in mu ignore `mu`.
     fn build(&self, op: &FrictionalOperator, mu: f64, band_hz: (f64, f64)) -> Result<Basis>;
+}
+
+/// The contact problem condensed on the pairs after one Cholesky factorization of `K`:
+/// gaps `g = q + (W + mu Wnt) Rn` with `q = g0 + Pn K^-1 F`, `W = Pn K^-1 Pn^T` and
+/// `Wnt = Pn K^-1 Pt^T` (contact flexibilities, m/N). Shared by every equilibrium
+/// solver; it keeps the factorization to recover displacements.
+pub struct Condensation {
+    factor: Cholesky,
+    /// `W = Pn K^-1 Pn^T` (m/N), symmetric positive definite.
+    pub w: Mat<f64>,
+    /// `Wnt = Pn K^-1 Pt^T` (m/N).
+    pub wnt: Mat<f64>,
+    /// Gaps under the external load alone, `g0 + Pn K^-1 F` (m).
+    pub q: Vec<f64>,
+    /// Wall time of the condensation (s).
+    pub time_s: f64,
+}
+
+impl Condensation {
+    /// Factorizes `K` once and solves for the `2 nc` unit contact loads (in blocks).
+    pub fn new(problem: &ContactProblem<'_>) -> Result<Self> {
+        let start = std::time::Instant::now();
+        let n = problem.k.nrows();
+        let nc = problem.pn.nrows();
+        check_problem(problem)?;
+        let factor = Cholesky::new(problem.k, "K (contact condensation)")?;
+        let pnt = transpose(problem.pn);
+        let ptt = transpose(problem.pt);
+        let mut w = Mat::<f64>::zeros(nc, nc);
+        let mut wnt = Mat::<f64>::zeros(nc, nc);
+        const BLOCK: usize = 64;
+        for (src, dst) in [(&pnt, &mut w), (&ptt, &mut wnt)] {
+            let mut c0 = 0;
+            while c0 < nc {
+                let b = BLOCK.min(nc - c0);
+                let mut x = Mat::<f64>::zeros(n, b);
+                for c in 0..b {
+                    let a = src.as_ref();
+                    for (r, v) in a.row_idx_of_col(c0 + c).zip(a.val_of_col(c0 + c)) {
+                        x[(r, c)] = *v;
+                    }
+                }
+                factor.solve_in_place(x.as_mut());
+                let y = sparse_times_dense(problem.pn, x.as_ref());
+                dst.as_mut().subcols_mut(c0, b).copy_from(&y);
+                c0 += b;
+            }
+        }
+        let mut kf = problem.f.to_vec();
+        factor.solve_vec_in_place(&mut kf);
+        let mut q = vec![0.0; nc];
+        spmv(problem.pn, &kf, &mut q);
+        q.iter_mut().zip(problem.g0).for_each(|(a, b)| *a += b);
+        Ok(Self {
+            factor,
+            w,
+            wnt,
+            q,
+            time_s: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Number of pairs.
+    pub fn pairs(&self) -> usize {
+        self.q.len()
+    }
+
+    /// The LCP matrix `W + mu Wnt + c I` of a law with compliance `c`.
+    pub fn lcp_matrix(&self, mu: f64, compliance: f64) -> Mat<f64> {
+        let nc = self.pairs();
+        Mat::from_fn(nc, nc, |i, j| {
+            self.w[(i, j)] + mu * self.wnt[(i, j)] + if i == j { compliance } else { 0.0 }
+        })
+    }
+
+    /// Builds the [`Equilibrium`] of reactions `rn`: displacements from one solve with
+    /// the kept factorization, the global equilibrium residual as a backward error
+    /// `||K U - F - (Pn + mu Pt)^T Rn|| / (||K||_1 ||U|| + ||F + (Pn + mu Pt)^T Rn||)`
+    /// (relative to the load alone it would measure the cancellation in `K U`, about
+    /// `cond(K)` times round-off, rather than the solve), the complementarity
+    /// residual (largest of: negative reaction / total, penetration beyond the law's
+    /// compliance / gap scale, `Rn_i g_i` / (total x gap scale)), and the active set
+    /// `Rn_i > 1e-9 max Rn`.
+    pub fn finish(
+        &self,
+        problem: &ContactProblem<'_>,
+        law: &dyn ContactLaw,
+        rn: Vec<f64>,
+        mu: f64,
+        iterations: usize,
+        time_s: f64,
+    ) -> Result<Equilibrium> {
+        if !rn.iter().any(|&r| r > 0.0) {
+            return Err(Error::Invalid(format!(
+                "no contact: the load opens every one of the {} pairs (is the disc pressed \
+                 towards the pin?)",
+                rn.len()
+            )));
+        }
+        let n = problem.k.nrows();
+        let mut load = problem.f.to_vec();
+        add_transpose_times(problem.pn, &rn, 1.0, &mut load);
+        add_transpose_times(problem.pt, &rn, mu, &mut load);
+        let mut u = load.clone();
+        self.factor.solve_vec_in_place(&mut u);
+        let mut ku = vec![0.0; n];
+        spmv(problem.k, &u, &mut ku);
+        let r: Vec<f64> = ku.iter().zip(&load).map(|(a, b)| a - b).collect();
+        let equilibrium_residual = norm2(&r)
+            / (crate::linalg::norm1(problem.k) * norm2(&u) + norm2(&load)).max(f64::MIN_POSITIVE);
+        let mut g = vec![0.0; rn.len()];
+        spmv(problem.pn, &u, &mut g);
+        g.iter_mut().zip(problem.g0).for_each(|(a, b)| *a += b);
+        let c = law.compliance();
+        let total: f64 = rn.iter().sum::<f64>().abs().max(f64::MIN_POSITIVE);
+        let gscale = self
+            .q
+            .iter()
+            .fold(0.0f64, |a, b| a.max(b.abs()))
+            .max(f64::MIN_POSITIVE);
+        let mut comp = 0.0f64;
+        for (ri, gi) in rn.iter().zip(&g) {
+            let gap = gi + c * ri; // zero for a closed pair under the law
+            comp = comp
+                .max((-ri).max(0.0) / total)
+                .max((-gap).max(0.0) / gscale)
+                .max((ri.max(0.0) / total) * (gap.abs() / gscale));
+        }
+        let rmax = rn.iter().fold(0.0f64, |a, &b| a.max(b));
+        let active = rn.iter().map(|&r| r > 1e-9 * rmax).collect();
+        Ok(Equilibrium {
+            mu,
+            u,
+            rn,
+            active,
+            iterations,
+            factorizations: 1,
+            equilibrium_residual,
+            complementarity_residual: comp,
+            time_s,
+        })
+    }
+}
+
+/// Rejects a non-finite friction coefficient (a negative one is valid here: it is the
+/// same as reversing the rotation; user-facing inputs reject it earlier).
+pub fn check_mu(mu: f64) -> Result<()> {
+    if mu.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::param(
+            "mu",
+            format!("expected a finite friction coefficient, got {mu}"),
+        ))
+    }
+}
+
+fn check_problem(p: &ContactProblem<'_>) -> Result<()> {
+    let n = p.k.nrows();
+    let nc = p.pn.nrows();
+    if nc == 0 {
+        return Err(Error::Invalid(
+            "the contact problem has no contact pairs".into(),
+        ));
+    }
+    for (what, got, want) in [
+        ("Pn columns", p.pn.ncols(), n),
+        ("Pt columns", p.pt.ncols(), n),
+        ("Pt rows", p.pt.nrows(), nc),
+        ("F length", p.f.len(), n),
+        ("g0 length", p.g0.len(), nc),
+    ] {
+        if got != want {
+            return Err(Error::Dimension {
+                context: format!("contact problem: {what}"),
+                expected: want,
+                got,
+            });
+        }
+    }
+    if p.f.iter().chain(p.g0).any(|v| !v.is_finite()) {
+        return Err(Error::Invalid(
+            "contact problem: F or g0 holds NaN or infinite values".into(),
+        ));
+    }
+    Ok(())
+}
+
+fn transpose(a: SparseRef<'_>) -> SparseMat {
+    let mut t = Vec::with_capacity(a.compute_nnz());
+    for j in 0..a.ncols() {
+        for (r, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
+            t.push(Triplet::new(j, r, *v));
+        }
+    }
+    SparseMat::try_new_from_triplets(a.ncols(), a.nrows(), &t).expect("valid transpose")
+}
+
+/// `A X` for sparse `A` and dense `X`.
+pub fn sparse_times_dense(a: SparseRef<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
+    let mut y = Mat::<f64>::zeros(a.nrows(), x.ncols());
+    for j in 0..a.ncols() {
+        for (r, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
+            for c in 0..x.ncols() {
+                y[(r, c)] += v * x[(j, c)];
+            }
+        }
+    }
+    y
+}
+
+/// `y += alpha A^T x`.
+pub fn add_transpose_times(a: SparseRef<'_>, x: &[f64], alpha: f64, y: &mut [f64]) {
+    for j in 0..a.ncols() {
+        let s: f64 = a
+            .row_idx_of_col(j)
+            .zip(a.val_of_col(j))
+            .map(|(r, v)| v * x[r])
+            .sum();
+        y[j] += alpha * s;
+    }
+}
+
+/// Outcome of [`solve_lcp`].
+#[derive(Debug, Clone)]
+pub struct LcpSolution {
+    /// The solution `z >= 0`.
+    pub z: Vec<f64>,
+    /// `w = q + A z >= 0`.
+    pub w: Vec<f64>,
+    /// Pivoting iterations (one dense solve each).
+    pub iterations: usize,
+}
+
+/// Solves the linear complementarity problem `0 <= z ⟂ w = q + A z >= 0` exactly by
+/// block principal pivoting (Júdice and Pires), falling back to Murty's single
+/// least-index pivot when the number of infeasibilities stops decreasing: finite for a
+/// P-matrix `A` (e.g. `W + mu Wnt` below the flutter of the contact problem, or a
+/// symmetric positive definite `W`). Tolerances are relative to `max |q|` and `max |z|`.
+pub fn solve_lcp(a: MatRef<'_, f64>, q: &[f64], max_iterations: usize) -> Result<LcpSolution> {
+    let n = q.len();
+    if a.nrows() != n || a.ncols() != n {
+        return Err(Error::Dimension {
+            context: "LCP matrix".into(),
+            expected: n,
+            got: a.nrows(),
+        });
+    }
+    if q.iter().any(|v| !v.is_finite()) || (0..n).any(|j| (0..n).any(|i| !a[(i, j)].is_finite())) {
+        return Err(Error::Invalid(
+            "LCP data hold NaN or infinite values".into(),
+        ));
+    }
+    let qscale = q.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut basic: Vec<bool> = q.iter().map(|&v| v < 0.0).collect();
+    let mut best = usize::MAX;
+    let mut trials = 3;
+    let mut z = vec![0.0; n];
+    let mut w = q.to_vec();
+    let mut last = (0usize, 0.0f64, 0.0f64);
+    for it in 1..=max_iterations {
+        let s: Vec<usize> = (0..n).filter(|&i| basic[i]).collect();
+        z.iter_mut().for_each(|v| *v = 0.0);
+        if !s.is_empty() {
+            let ass = Mat::from_fn(s.len(), s.len(), |i, j| a[(s[i], s[j])]);
+            let rhs = Mat::from_fn(s.len(), 1, |i, _| -q[s[i]]);
+            let zs = faer::linalg::solvers::Solve::solve(&ass.partial_piv_lu(), &rhs);
+            for (k, &i) in s.iter().enumerate() {
+                z[i] = zs[(k, 0)];
+            }
+        }
+        for i in 0..n {
+            w[i] = q[i] + s.iter().map(|&j| a[(i, j)] * z[j]).sum::<f64>();
+        }
+        if z.iter().chain(&w).any(|v| !v.is_finite()) {
+            return Err(Error::NotConverged {
+                method: "LCP block pivoting".into(),
+                iterations: it,
+                detail: "singular principal submatrix: the LCP matrix is not a P-matrix \
+                         (friction too high for a unique sliding equilibrium?)"
+                    .into(),
+            });
+        }
+        let zscale = z
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(f64::MIN_POSITIVE);
+        let (ez, ew) = (1e-12 * zscale, 1e-12 * qscale.max(f64::MIN_POSITIVE));
+        let bad: Vec<usize> = (0..n)
+            .filter(|&i| (basic[i] && z[i] < -ez) || (!basic[i] && w[i] < -ew))
+            .collect();
+        if bad.is_empty() {
+            for i in 0..n {
+                if basic[i] {
+                    w[i] = 0.0; // w_S = 0 up to round-off
+                } else {
+                    z[i] = 0.0;
+                }
+            }
+            return Ok(LcpSolution {
+                z: z.iter().map(|v| v.max(0.0)).collect(),
+                w,
+                iterations: it,
+            });
+        }
+        let worst_z = bad
+            .iter()
+            .filter(|&&i| basic[i])
+            .map(|&i| -z[i])
+            .fold(0.0, f64::max);
+        let worst_w = bad
+            .iter()
+            .filter(|&&i| !basic[i])
+            .map(|&i| -w[i])
+            .fold(0.0, f64::max);
+        last = (bad.len(), worst_z, worst_w);
+        if bad.len() < best {
+            best = bad.len();
+            trials = 3;
+            bad.iter().for_each(|&i| basic[i] = !basic[i]);
+        } else if trials > 0 {
+            trials -= 1;
+            bad.iter().for_each(|&i| basic[i] = !basic[i]);
+        } else {
+            let i = bad[0]; // Murty: least index
+
+            basic[i] = !basic[i];
+        }
+    }
+    Err(Error::NotConverged {
+        method: "LCP block pivoting".into(),
+        iterations: max_iterations,
+        detail: format!(
+            "{} infeasible pairs left (largest negative reaction {:.3e}, largest \
+             penetration {:.3e})",
+            last.0, last.1, last.2
+        ),
+    })
 }

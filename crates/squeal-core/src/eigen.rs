@@ -10,8 +10,8 @@
 //! Residual of a pair: `||K x - omega^2 M x|| / ((||K||_1 + omega^2 ||M||_1) ||x||)`,
 //! a relative backward error.
 
-use crate::linalg::{norm1, norm2, spmv, ShiftInvert};
 use crate::contact::FrictionalOperator;
+use crate::linalg::{norm1, norm2, spmv, ShiftInvert};
 use crate::qep::{ComplexModes, Qep};
 use crate::{Error, Result, SparseRef};
 use faer::Mat;

@@ -24,7 +24,6 @@ pub mod qep;
 pub mod registry;
 
 pub use contact::{ContactLaw, EquilibriumSolver, FrictionalOperator, ReductionBasis};
-pub use qep::{ComplexKernel, ComplexKernelOutput, ComplexLinOp, ComplexModes, Qep};
 pub use eigen::{
     solve_symmetric_band, EigenParams, EigenSolver, KernelOutput, RealModes, SolveInfo, StopReason,
     SymmetricKernel, SymmetricProblem,
@@ -32,6 +31,7 @@ pub use eigen::{
 pub use error::{Error, Result};
 pub use material::{Material, Voigt6};
 pub use params::{ParamValue, Params};
+pub use qep::{ComplexKernel, ComplexKernelOutput, ComplexLinOp, ComplexModes, Qep};
 pub use registry::Registry;
 
 pub use faer;

@@ -86,6 +86,50 @@ pub fn check_square_finite(a: SparseRef<'_>, n: usize, what: &str) -> Result<()>
     Ok(())
 }
 
+/// A sparse Cholesky factorization `A = L L^T` of a symmetric positive definite matrix
+/// (faer supernodal), solved against one or many right-hand sides.
+pub struct Cholesky {
+    llt: Llt<usize, f64>,
+    n: usize,
+}
+
+impl Cholesky {
+    /// Factorizes `a`; `what` names the matrix in errors.
+    pub fn new(a: SparseRef<'_>, what: &str) -> Result<Self> {
+        let n = a.nrows();
+        check_square_finite(a, n, what)?;
+        let fail = |reason: String| Error::Factorization {
+            what: format!("{what} (n = {n})"),
+            reason,
+        };
+        let symbolic =
+            SymbolicLlt::try_new(a.symbolic(), Side::Lower).map_err(|e| fail(format!("{e:?}")))?;
+        let llt = Llt::try_new_with_symbolic(symbolic, a, Side::Lower).map_err(|e| {
+            fail(format!(
+                "{e:?} (not positive definite: are the rigid-body motions restrained?)"
+            ))
+        })?;
+        Ok(Self { llt, n })
+    }
+
+    /// Size.
+    pub fn dim(&self) -> usize {
+        self.n
+    }
+
+    /// `B <- A^-1 B` for a block of right-hand sides (columns).
+    pub fn solve_in_place(&self, b: MatMut<'_, f64>) {
+        self.llt.solve_in_place(b);
+    }
+
+    /// `y <- A^-1 y`.
+    pub fn solve_vec_in_place(&self, y: &mut [f64]) {
+        let n = y.len();
+        self.llt
+            .solve_in_place(MatMut::from_column_major_slice_mut(y, n, 1));
+    }
+}
+
 /// The factorized symmetric shift-invert operator `OP = (K - sigma M)^-1 M`.
 pub struct ShiftInvert<'a> {
     m: SparseRef<'a>,
