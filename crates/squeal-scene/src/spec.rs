@@ -9,6 +9,12 @@ use std::collections::BTreeMap;
 /// The embedded default scene, the paper's pin-on-disc rig.
 pub const PIN_ON_DISC: &str = include_str!("../../../scenes/pin-on-disc.toml");
 
+/// The same rig meshed at the paper's model size (about 300 000 DOFs).
+pub const PIN_ON_DISC_PAPER: &str = include_str!("../../../scenes/pin-on-disc-paper.toml");
+
+/// Names of the embedded scenes.
+pub const BUILTIN_SCENES: [&str; 2] = ["pin-on-disc", "pin-on-disc-paper"];
+
 /// A material: plugin name plus its constants.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MaterialSpec {
@@ -272,14 +278,20 @@ impl Scene {
         Self::from_toml(&text, &file)
     }
 
-    /// An embedded scene by name (`pin-on-disc`).
+    /// An embedded scene by name (`pin-on-disc`, `pin-on-disc-paper`).
     pub fn builtin(name: &str) -> Result<Scene> {
         match name {
             "pin-on-disc" => Self::from_toml(PIN_ON_DISC, "<builtin pin-on-disc>"),
+            "pin-on-disc-paper" => {
+                Self::from_toml(PIN_ON_DISC_PAPER, "<builtin pin-on-disc-paper>")
+            }
             other => Err(SceneError::Field {
                 file: format!("<builtin {other}>"),
                 field: "name".into(),
-                message: "no such embedded scene; available: pin-on-disc".into(),
+                message: format!(
+                    "no such embedded scene; available: {}",
+                    BUILTIN_SCENES.join(", ")
+                ),
             }),
         }
     }
