@@ -115,36 +115,69 @@ impl ContactSet {
             }
             Ok(d)
         };
-        let n = model.dofs.n_free();
-        let mut set = ContactSet {
-            grid_index: Vec::new(),
-            xy: Vec::new(),
-            pin_dofs: Vec::new(),
-            disc_dofs: Vec::new(),
-            direction: Vec::new(),
-            pn: SparseMat::try_new_from_triplets(0, n, &[]).expect("empty"),
-            pt: SparseMat::try_new_from_triplets(0, n, &[]).expect("empty"),
-            rotation,
-        };
+        let mut xy = Vec::new();
+        let mut pin_dofs = Vec::new();
+        let mut disc_dofs = Vec::new();
+        let mut index = Vec::new();
         for p in (0..grid.len()).filter(|&p| inside(p)) {
-            let [x, y] = grid.xy[p];
-            let r = x.hypot(y);
-            set.grid_index.push(p);
-            set.xy.push([x, y]);
-            set.pin_dofs.push(dof(grid.pin_nodes[p], "pin")?);
-            set.disc_dofs.push(dof(grid.disc_nodes[p], "disc")?);
-            set.direction
-                .push([-rotation * y / r, rotation * x / r, 0.0]);
+            index.push(p);
+            xy.push(grid.xy[p]);
+            pin_dofs.push(dof(grid.pin_nodes[p], "pin")?);
+            disc_dofs.push(dof(grid.disc_nodes[p], "disc")?);
         }
-        if set.grid_index.is_empty() {
+        if index.is_empty() {
             return Err(ContactError::Setup {
                 field: "contact.zone".into(),
                 message: "the zone holds no contact pair".into(),
             });
         }
+        let mut set = Self::from_pairs(model.dofs.n_free(), xy, pin_dofs, disc_dofs, rotation)?;
+        set.grid_index = index;
+        Ok(set)
+    }
+
+    /// A contact set from explicit pairs on a model with `n` free DOFs: pair `i` joins
+    /// the pin node with free DOFs `pin_dofs[i]` to the disc node with `disc_dofs[i]` at
+    /// `xy[i]` (m, the disc axis at the origin). Normals are `+e_z`.
+    pub fn from_pairs(
+        n: usize,
+        xy: Vec<[f64; 2]>,
+        pin_dofs: Vec<[usize; 3]>,
+        disc_dofs: Vec<[usize; 3]>,
+        rotation: f64,
+    ) -> Result<Self> {
+        let nc = xy.len();
+        if pin_dofs.len() != nc || disc_dofs.len() != nc {
+            return Err(ContactError::Setup {
+                field: "pairs".into(),
+                message: format!(
+                    "{nc} positions but {} pin and {} disc DOF triples",
+                    pin_dofs.len(),
+                    disc_dofs.len()
+                ),
+            });
+        }
+        if let Some(d) = pin_dofs
+            .iter()
+            .chain(&disc_dofs)
+            .flatten()
+            .find(|&&d| d >= n)
+        {
+            return Err(ContactError::Setup {
+                field: "pairs".into(),
+                message: format!("DOF {d} out of range (the model has {n} free DOFs)"),
+            });
+        }
+        let direction: Vec<[f64; 3]> = xy
+            .iter()
+            .map(|&[x, y]| {
+                let r = x.hypot(y);
+                [-rotation * y / r, rotation * x / r, 0.0]
+            })
+            .collect();
         let (mut tn, mut tt) = (Vec::new(), Vec::new());
-        for i in 0..set.len() {
-            let (s, m, e) = (set.pin_dofs[i], set.disc_dofs[i], set.direction[i]);
+        for i in 0..nc {
+            let (s, m, e) = (pin_dofs[i], disc_dofs[i], direction[i]);
             tn.push(Triplet::new(i, s[2], 1.0));
             tn.push(Triplet::new(i, m[2], -1.0));
             for a in 0..3 {
@@ -154,16 +187,24 @@ impl ContactSet {
                 }
             }
         }
-        let nc = set.len();
-        set.pn = SparseMat::try_new_from_triplets(nc, n, &tn).map_err(|e| ContactError::Setup {
-            field: "pin".into(),
+        let pn = SparseMat::try_new_from_triplets(nc, n, &tn).map_err(|e| ContactError::Setup {
+            field: "pairs".into(),
             message: format!("building Pn: {e:?}"),
         })?;
-        set.pt = SparseMat::try_new_from_triplets(nc, n, &tt).map_err(|e| ContactError::Setup {
-            field: "pin".into(),
+        let pt = SparseMat::try_new_from_triplets(nc, n, &tt).map_err(|e| ContactError::Setup {
+            field: "pairs".into(),
             message: format!("building Pt: {e:?}"),
         })?;
-        Ok(set)
+        Ok(ContactSet {
+            grid_index: (0..nc).collect(),
+            xy,
+            pin_dofs,
+            disc_dofs,
+            direction,
+            pn,
+            pt,
+            rotation,
+        })
     }
 
     /// Number of candidate pairs.
