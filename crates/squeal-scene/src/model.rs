@@ -486,7 +486,7 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
         .as_ref()
         .map(|p| Patch::new(p, rule.pin_face_elements));
 
-    if matches!(which, BodyKind::Disc | BodyKind::All) {
+    if which == BodyKind::Disc || (which == BodyKind::All && scene.disc.is_some()) {
         let d = scene.disc.as_ref().ok_or_else(|| missing("disc"))?;
         let m = mat(&d.material, "disc.material")?;
         let (lambda, h) = element_size(
@@ -618,7 +618,7 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
         body_names.push("disc".to_string());
     }
 
-    if matches!(which, BodyKind::Pin | BodyKind::All) {
+    if which == BodyKind::Pin || (which == BodyKind::All && scene.pin.is_some()) {
         let p = scene.pin.as_ref().ok_or_else(|| missing("pin"))?;
         let pin_mat = mat(&p.material, "pin.material")?;
         let (a, b, yc) = (p.size_x_m, p.size_y_m, p.center_radius_m);
