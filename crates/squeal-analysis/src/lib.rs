@@ -9,3 +9,4 @@ pub mod labels;
 pub mod modal;
 pub mod pipeline;
 pub mod reference;
+pub mod vtu;

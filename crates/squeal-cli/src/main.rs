@@ -3,6 +3,7 @@
 mod equilibrium;
 mod modes;
 mod scene_cmd;
+mod stability;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -45,6 +46,9 @@ enum Command {
         /// Write the modes as JSON here.
         #[arg(long)]
         json: Option<std::path::PathBuf>,
+        /// Write the mesh and mode shapes for ParaView here (VTU files + modes.pvd).
+        #[arg(long)]
+        vtu: Option<std::path::PathBuf>,
     },
     /// The main job: the uniform-contact validation on the embedded default scene
     /// (for now: the disc's normal modes against Table 2 of the paper).
@@ -79,6 +83,39 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "out/equilibrium")]
         out: std::path::PathBuf,
+    },
+    /// Complex modes of the frictional operator (full order): of a scene at its sliding
+    /// equilibrium, or of an operator directory (`--operator DIR`).
+    Stability {
+        /// Scene file (TOML) or embedded scene name; default: `pin-on-disc`.
+        scene: Option<String>,
+        /// Operator directory (Mc.mtx, Kc.mtx, ... as written by `squeal export`).
+        #[arg(long)]
+        operator: Option<std::path::PathBuf>,
+        /// Friction coefficient (default: the scene's study.mu; required with --operator).
+        #[arg(long)]
+        mu: Option<f64>,
+        /// Eigen solver plugin (`arpack`, `krylov`, `dense`).
+        #[arg(long, default_value = "arpack")]
+        eigen: String,
+        /// Frequency band `FMIN:FMAX` in Hz.
+        #[arg(long, default_value = "0:10000")]
+        band: String,
+        /// Relative tolerance of the eigen solver.
+        #[arg(long, default_value_t = 1e-12)]
+        tol: f64,
+        /// A mode is unstable when Re(lambda) > this times |lambda|.
+        #[arg(long, default_value_t = 1e-8)]
+        unstable_tol: f64,
+        /// Equilibrium solver plugin.
+        #[arg(long, default_value = "lcp")]
+        equilibrium: String,
+        /// Contact law plugin.
+        #[arg(long, default_value = "lagrange")]
+        law: String,
+        /// Write the result as JSON here.
+        #[arg(long)]
+        json: Option<std::path::PathBuf>,
     },
     /// Lists the registered plugins.
     Plugins,
@@ -118,6 +155,23 @@ pub fn load_scene(arg: Option<&str>) -> Result<(Scene, String)> {
     }
 }
 
+/// Parses `FMIN:FMAX` (Hz).
+pub fn parse_band(text: &str) -> Result<[f64; 2]> {
+    let (a, b) = text
+        .split_once(':')
+        .with_context(|| format!("--band `{text}`: expected FMIN:FMAX in Hz, e.g. 0:10000"))?;
+    let parse = |s: &str| -> Result<f64> {
+        s.trim()
+            .parse::<f64>()
+            .with_context(|| format!("--band `{text}`: `{s}` is not a frequency in Hz"))
+    };
+    let band = [parse(a)?, parse(b)?];
+    if !(band[0] >= 0.0 && band[1] > band[0] && band[1].is_finite()) {
+        anyhow::bail!("--band `{text}`: expected 0 <= FMIN < FMAX (Hz)");
+    }
+    Ok(band)
+}
+
 fn main() {
     if let Err(e) = run() {
         eprintln!("error: {e:#}");
@@ -136,13 +190,22 @@ fn run() -> Result<()> {
             eigen,
             tol,
             json,
+            vtu,
         } => {
             let which = match body {
                 Body::Disc => squeal_scene::BodyKind::Disc,
                 Body::Pin => squeal_scene::BodyKind::Pin,
                 Body::All => squeal_scene::BodyKind::All,
             };
-            let report = modes::run(&registry, scene.as_deref(), which, max_freq, &eigen, tol)?;
+            let report = modes::run(
+                &registry,
+                scene.as_deref(),
+                which,
+                max_freq,
+                &eigen,
+                tol,
+                vtu.as_deref(),
+            )?;
             print!("{}", modes::format(&report));
             if let Some(path) = json {
                 modes::write_json(&report, &path)?;
@@ -156,6 +219,7 @@ fn run() -> Result<()> {
                 10_500.0,
                 &eigen,
                 1e-12,
+                None,
             )?;
             let rows = squeal_analysis::modal::compare_table2(&report.modes);
             println!("Disc normal modes (free friction face): paper Table 2 vs squeal");
@@ -254,6 +318,36 @@ fn run() -> Result<()> {
             }
             for p in equilibrium::outputs(&out, &reports) {
                 println!("wrote {}", p.display());
+            }
+        }
+        Command::Stability {
+            scene,
+            operator,
+            mu,
+            eigen,
+            band,
+            tol,
+            unstable_tol,
+            equilibrium,
+            law,
+            json,
+        } => {
+            let args = stability::Args {
+                scene: scene.as_deref(),
+                operator: operator.as_deref(),
+                mu,
+                eigen: &eigen,
+                band: parse_band(&band)?,
+                tol,
+                unstable_tol,
+                equilibrium: &equilibrium,
+                law: &law,
+            };
+            let report = stability::run(&registry, &args)?;
+            stability::print(&report);
+            if let Some(path) = json {
+                std::fs::write(&path, serde_json::to_string_pretty(&report)?)
+                    .with_context(|| format!("writing {}", path.display()))?;
             }
         }
         Command::Plugins => {

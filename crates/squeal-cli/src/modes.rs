@@ -32,6 +32,7 @@ pub fn run(
     max_freq: f64,
     eigen: &str,
     tol: f64,
+    vtu: Option<&std::path::Path>,
 ) -> Result<ModesReport> {
     let start = Instant::now();
     let (scene, file) = crate::load_scene(scene)?;
@@ -44,6 +45,24 @@ pub fn run(
     };
     let (modes, records) = normal_modes(&model, solver.as_ref(), &params)
         .with_context(|| format!("normal modes of {file} with `{eigen}`"))?;
+    if let Some(dir) = vtu {
+        let shapes: Vec<(f64, Vec<f64>)> = (0..modes.freq_hz.len())
+            .map(|i| {
+                let col: Vec<f64> = modes.vectors.col(i).iter().copied().collect();
+                (
+                    modes.freq_hz[i],
+                    squeal_analysis::vtu::nodal(&model.dofs.free_of_full, &col),
+                )
+            })
+            .collect();
+        let written = squeal_analysis::vtu::write_modes(dir, &model.mesh, &shapes)
+            .with_context(|| format!("writing VTU files to {}", dir.display()))?;
+        eprintln!(
+            "wrote {} VTU files and {}",
+            written.len() - 1,
+            dir.join("modes.pvd").display()
+        );
+    }
     Ok(ModesReport {
         scene: file,
         units: "SI: frequencies in Hz, masses in kg, times in s",

@@ -1,0 +1,195 @@
+//! `squeal stability`: complex modes of the frictional operator of a scene (after its
+//! sliding equilibrium) or of an operator directory.
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+use squeal_analysis::pipeline::{solve_modes, Prepared};
+use squeal_core::{EigenParams, FrictionalOperator, Registry};
+use std::path::Path;
+use std::time::Instant;
+
+/// One mode in the JSON output.
+#[derive(Serialize)]
+pub struct ModeOut {
+    pub freq_hz: f64,
+    pub re: f64,
+    pub im: f64,
+    pub dvr: f64,
+    pub unstable: bool,
+    pub backward_error: f64,
+}
+
+/// What `squeal stability --json` writes.
+#[derive(Serialize)]
+pub struct StabilityReport {
+    pub source: String,
+    pub units: &'static str,
+    pub dofs: usize,
+    pub full_dofs: usize,
+    pub mu: f64,
+    pub eigen: String,
+    pub band_hz: [f64; 2],
+    pub tol: f64,
+    pub unstable_tol: f64,
+    pub active_pairs: Option<usize>,
+    pub pairs: Option<usize>,
+    pub equilibrium_time_s: f64,
+    pub operator_time_s: f64,
+    pub solve_time_s: f64,
+    pub time_s: f64,
+    pub converged: usize,
+    pub reason: String,
+    pub factorizations: usize,
+    pub notes: Vec<String>,
+    pub max_backward_error: f64,
+    pub modes: Vec<ModeOut>,
+}
+
+/// Inputs of one stability run.
+pub struct Args<'a> {
+    pub scene: Option<&'a str>,
+    pub operator: Option<&'a Path>,
+    pub mu: Option<f64>,
+    pub eigen: &'a str,
+    pub band: [f64; 2],
+    pub tol: f64,
+    pub unstable_tol: f64,
+    pub equilibrium: &'a str,
+    pub law: &'a str,
+}
+
+/// The operator of a scene at its equilibrium, or read from a directory.
+pub struct Source {
+    pub name: String,
+    pub op: FrictionalOperator,
+    pub mu: f64,
+    pub active_pairs: Option<usize>,
+    pub pairs: Option<usize>,
+    pub equilibrium_time_s: f64,
+    pub operator_time_s: f64,
+}
+
+pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
+    if let Some(dir) = a.operator {
+        if a.scene.is_some() {
+            anyhow::bail!("give either a scene or --operator DIR, not both");
+        }
+        let start = Instant::now();
+        let op = read_operator_dir(dir)?;
+        let mu = a.mu.context("--mu is required with --operator")?;
+        squeal_contact::check_user_mu(mu)?;
+        return Ok(Source {
+            name: dir.display().to_string(),
+            op,
+            mu,
+            active_pairs: None,
+            pairs: None,
+            equilibrium_time_s: 0.0,
+            operator_time_s: start.elapsed().as_secs_f64(),
+        });
+    }
+    let (scene, file) = crate::load_scene(a.scene)?;
+    let mu = a.mu.unwrap_or(scene.study.mu);
+    let prep = Prepared::new(registry, scene, &file)?;
+    let t0 = Instant::now();
+    let eq = prep.equilibrium(registry, a.equilibrium, a.law, mu)?;
+    let equilibrium_time_s = t0.elapsed().as_secs_f64() + prep.condensation.time_s;
+    let t1 = Instant::now();
+    let op = prep.operator(&eq.eq.active)?;
+    Ok(Source {
+        name: file,
+        op,
+        mu,
+        active_pairs: Some(eq.eq.active.iter().filter(|&&x| x).count()),
+        pairs: Some(prep.set.len()),
+        equilibrium_time_s,
+        operator_time_s: t1.elapsed().as_secs_f64(),
+    })
+}
+
+pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
+    let start = Instant::now();
+    let src = source(registry, a)?;
+    let params = EigenParams {
+        fmin_hz: a.band[0],
+        fmax_hz: a.band[1],
+        tol: a.tol,
+        ..EigenParams::default()
+    };
+    let (modes, _) = solve_modes(registry, &src.op, src.mu, a.eigen, &params)?;
+    let out: Vec<ModeOut> = (0..modes.len())
+        .map(|i| ModeOut {
+            freq_hz: modes.freq_hz[i],
+            re: modes.lambda[i].re,
+            im: modes.lambda[i].im,
+            dvr: modes.dvr[i],
+            unstable: modes.is_unstable(i, a.unstable_tol),
+            backward_error: modes.backward_error[i],
+        })
+        .collect();
+    Ok(StabilityReport {
+        source: src.name,
+        units: "SI: frequencies in Hz, real parts in 1/s, times in s; DvR = Re/Im",
+        dofs: src.op.dim(),
+        full_dofs: src.op.full_dim(),
+        mu: src.mu,
+        eigen: a.eigen.into(),
+        band_hz: a.band,
+        tol: a.tol,
+        unstable_tol: a.unstable_tol,
+        active_pairs: src.active_pairs,
+        pairs: src.pairs,
+        equilibrium_time_s: src.equilibrium_time_s,
+        operator_time_s: src.operator_time_s,
+        solve_time_s: modes.info.time_s,
+        time_s: start.elapsed().as_secs_f64(),
+        converged: modes.info.converged,
+        reason: format!("{:?}", modes.info.reason),
+        factorizations: modes.info.factorizations,
+        notes: modes.info.notes.clone(),
+        max_backward_error: modes.backward_error.iter().fold(0.0, |m: f64, &b| m.max(b)),
+        modes: out,
+    })
+}
+
+pub fn print(r: &StabilityReport) {
+    println!(
+        "{}: {} DOFs (constrained; {} full), mu = {}, `{}`: {} modes in {:?} Hz in {:.2} s",
+        r.source,
+        r.dofs,
+        r.full_dofs,
+        r.mu,
+        r.eigen,
+        r.modes.len(),
+        r.band_hz,
+        r.solve_time_s
+    );
+    if let (Some(a), Some(p)) = (r.active_pairs, r.pairs) {
+        println!("contact: {a} of {p} pairs active");
+    }
+    println!(
+        "{:>4} {:>12} {:>14} {:>12} {:>9} {:>10}",
+        "#", "freq (Hz)", "Re (1/s)", "DvR", "unstable", "backward"
+    );
+    for (i, m) in r.modes.iter().enumerate() {
+        println!(
+            "{:>4} {:>12.3} {:>14.6e} {:>12.4e} {:>9} {:>10.1e}",
+            i + 1,
+            m.freq_hz,
+            m.re,
+            m.dvr,
+            if m.unstable { "YES" } else { "" },
+            m.backward_error
+        );
+    }
+    for n in &r.notes {
+        println!("note: {n}");
+    }
+}
+
+fn read_operator_dir(dir: &Path) -> Result<FrictionalOperator> {
+    anyhow::bail!(
+        "{}: reading operator directories is not available in this build",
+        dir.display()
+    )
+}
