@@ -1,0 +1,509 @@
+//! Every chart function writes a parseable SVG and a PNG of the documented size, with the
+//! expected marks; bad input gives a `PlotError` naming the output and writes nothing.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use squeal_plot::{
+    bar_chart, contact_map, contact_map_size, line_chart, pareto_chart, pareto_front, ChartOptions,
+    MapPanel, PlotError, Series, SeriesStyle, CHART_SIZE,
+};
+
+/// A fresh directory under the system temp dir (never the repository).
+fn temp_dir(name: &str) -> PathBuf {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_nanos();
+    let dir = std::env::temp_dir().join(format!(
+        "squeal-plot-test-{}-{}-{}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::SeqCst),
+        nanos,
+        name
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Parsed SVG text plus helpers to count elements.
+struct Svg(String);
+
+impl Svg {
+    fn load(path: &Path) -> Svg {
+        let text = std::fs::read_to_string(path).unwrap();
+        roxmltree::Document::parse(&text)
+            .unwrap_or_else(|e| panic!("{} is not XML: {e}", path.display()));
+        Svg(text)
+    }
+    fn doc(&self) -> roxmltree::Document<'_> {
+        roxmltree::Document::parse(&self.0).unwrap()
+    }
+    fn count(&self, tag: &str) -> usize {
+        self.doc()
+            .descendants()
+            .filter(|n| n.has_tag_name(tag))
+            .count()
+    }
+    /// Elements `tag` whose attribute `attr` equals `value` (case-insensitive).
+    fn count_attr(&self, tag: &str, attr: &str, value: &str) -> usize {
+        self.doc()
+            .descendants()
+            .filter(|n| n.has_tag_name(tag))
+            .filter(|n| {
+                n.attribute(attr)
+                    .is_some_and(|v| v.eq_ignore_ascii_case(value))
+            })
+            .count()
+    }
+    /// Trimmed contents of every `<text>` element.
+    fn texts(&self) -> Vec<String> {
+        self.doc()
+            .descendants()
+            .filter(|n| n.has_tag_name("text"))
+            .map(|n| {
+                n.descendants()
+                    .filter(|c| c.is_text())
+                    .filter_map(|c| c.text())
+                    .collect::<String>()
+                    .trim()
+                    .to_string()
+            })
+            .collect()
+    }
+    fn has_text(&self, s: &str) -> bool {
+        self.texts().iter().any(|t| t == s)
+    }
+    fn size(&self) -> (u32, u32) {
+        let doc = self.doc();
+        let root = doc.root_element();
+        (
+            root.attribute("width").unwrap().parse().unwrap(),
+            root.attribute("height").unwrap().parse().unwrap(),
+        )
+    }
+}
+
+/// Checks the PNG signature and returns the IHDR width and height.
+fn png_size(path: &Path) -> (u32, u32) {
+    let b = std::fs::read(path).unwrap();
+    assert!(b.len() > 33, "{} too short", path.display());
+    assert_eq!(
+        &b[..8],
+        b"\x89PNG\r\n\x1a\n",
+        "{} signature",
+        path.display()
+    );
+    assert_eq!(&b[12..16], b"IHDR");
+    let be = |i: usize| u32::from_be_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]);
+    (be(16), be(20))
+}
+
+/// Both files exist as `<stem>.svg`, `<stem>.png` (in that order) with `size` pixels.
+fn check_outputs(stem: &Path, files: &[PathBuf], size: (u32, u32)) -> Svg {
+    let svg_path = PathBuf::from(format!("{}.svg", stem.display()));
+    let png_path = PathBuf::from(format!("{}.png", stem.display()));
+    assert_eq!(files, &[svg_path.clone(), png_path.clone()]);
+    assert_eq!(png_size(&png_path), size);
+    let svg = Svg::load(&svg_path);
+    assert_eq!(svg.size(), size);
+    svg
+}
+
+fn assert_names(err: &PlotError, stem: &Path) {
+    let msg = err.to_string();
+    assert!(
+        msg.contains(&stem.display().to_string()),
+        "error does not name {}: {msg}",
+        stem.display()
+    );
+    assert_eq!(err.path(), stem);
+    assert!(
+        !PathBuf::from(format!("{}.svg", stem.display())).exists()
+            && !PathBuf::from(format!("{}.png", stem.display())).exists(),
+        "files written despite {msg}"
+    );
+}
+
+// --------------------------------------------------------------------------- contact map
+
+/// An nx x ny grid of 1 mm pairs; value i (so pair 0 is open and the last is the maximum).
+fn grid_panel(title: &str, nx: usize, ny: usize) -> MapPanel {
+    let mut xy = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            xy.push([i as f64 * 1e-3, j as f64 * 1e-3]);
+        }
+    }
+    let values = (0..nx * ny).map(|i| i as f64).collect();
+    MapPanel {
+        title: title.into(),
+        xy,
+        values,
+        cell: [1e-3, 1e-3],
+        arrow: Some([0.0, 2.0]), // not unit: normalised by the function
+        arrow_label: "sliding".into(),
+    }
+}
+
+#[test]
+fn contact_map_writes_svg_and_png_with_one_rect_per_pair() {
+    let dir = temp_dir("contact");
+    let stem = dir.join("map");
+    let panels = [grid_panel("set A", 10, 4), grid_panel("set B", 6, 5)];
+    let files = contact_map(&stem, "Contact map title", "normal force (N)", &panels).unwrap();
+    let svg = check_outputs(&stem, &files, contact_map_size(2));
+    let pairs: usize = panels.iter().map(|p| p.xy.len()).sum();
+    assert!(svg.count("rect") >= pairs, "{} rects", svg.count("rect"));
+    // Shared scale: the overall maximum (39, panel A) is the top of viridis; panel B's
+    // maximum (29) is not. Pair 0 of each panel is open (light grey), + 1 legend swatch.
+    assert_eq!(svg.count_attr("rect", "fill", "#FDE725"), 1);
+    assert_eq!(svg.count_attr("rect", "fill", "#DEDEDE"), 2 + 1);
+    assert!(svg.has_text("Contact map title"));
+    assert!(svg.has_text("set A") && svg.has_text("set B"));
+    assert!(svg.has_text("x (mm)") && svg.has_text("y (mm)"));
+    assert!(svg.has_text("normal force (N)"));
+    assert_eq!(svg.texts().iter().filter(|t| *t == "sliding").count(), 2);
+    assert_eq!(svg.count("polygon"), 2, "one arrow head per panel");
+}
+
+#[test]
+fn contact_map_grid_beyond_three_panels() {
+    let dir = temp_dir("contact-grid");
+    let stem = dir.join("nested/dir/map"); // parent directories are created
+    let panels: Vec<MapPanel> = (0..5)
+        .map(|k| MapPanel {
+            arrow: None,
+            ..grid_panel(&format!("p{k}"), 3, 3)
+        })
+        .collect();
+    let files = contact_map(&stem, "five", "p (Pa)", &panels).unwrap();
+    assert_eq!(contact_map_size(5).1, 2 * contact_map_size(3).1 - 50);
+    let svg = check_outputs(&stem, &files, contact_map_size(5));
+    assert!(svg.count("rect") >= 45);
+    assert_eq!(svg.count("polygon"), 0);
+}
+
+#[test]
+fn contact_map_bad_input() {
+    let dir = temp_dir("contact-bad");
+    let stem = dir.join("map");
+    let err = contact_map(&stem, "t", "v", &[]).unwrap_err();
+    assert!(matches!(err, PlotError::EmptyData { .. }), "{err}");
+    assert_names(&err, &stem);
+
+    let empty = MapPanel {
+        xy: vec![],
+        values: vec![],
+        ..grid_panel("e", 1, 1)
+    };
+    let err = contact_map(&stem, "t", "v", &[grid_panel("a", 2, 2), empty]).unwrap_err();
+    assert!(matches!(err, PlotError::EmptyData { .. }), "{err}");
+    assert_names(&err, &stem);
+
+    let mut nan = grid_panel("n", 2, 2);
+    nan.values[3] = f64::NAN;
+    let err = contact_map(&stem, "t", "v", &[nan]).unwrap_err();
+    assert!(matches!(err, PlotError::NanData { .. }), "{err}");
+    assert_names(&err, &stem);
+
+    let mut nan = grid_panel("n", 2, 2);
+    nan.xy[1][1] = f64::INFINITY;
+    let err = contact_map(&stem, "t", "v", &[nan]).unwrap_err();
+    assert!(matches!(err, PlotError::NanData { .. }), "{err}");
+
+    let mut short = grid_panel("s", 2, 2);
+    short.values.pop();
+    let err = contact_map(&stem, "t", "v", &[short]).unwrap_err();
+    assert!(matches!(err, PlotError::InvalidInput { .. }), "{err}");
+    assert_names(&err, &stem);
+
+    let mut zero = grid_panel("z", 2, 2);
+    zero.arrow = Some([0.0, 0.0]);
+    assert!(matches!(
+        contact_map(&stem, "t", "v", &[zero]),
+        Err(PlotError::InvalidInput { .. })
+    ));
+}
+
+// --------------------------------------------------------------------------- line chart
+
+fn modes() -> Series {
+    Series {
+        name: "modes".into(),
+        points: vec![
+            (1000.0, -2.0),
+            (2000.0, -1.0),
+            (3000.0, 4.0),
+            (4000.0, 0.5),
+            (5000.0, -3.0),
+        ],
+        style: SeriesStyle::Markers,
+        highlight: vec![false, false, true, true, false],
+    }
+}
+
+fn curve() -> Series {
+    Series {
+        name: "fit".into(),
+        points: vec![(1000.0, -1.5), (2500.0, 0.0), (4000.0, 1.0), (5000.0, 2.0)],
+        style: SeriesStyle::Line,
+        highlight: vec![],
+    }
+}
+
+#[test]
+fn line_chart_markers_highlights_and_lines() {
+    let dir = temp_dir("line");
+    let stem = dir.join("stability");
+    let opts = ChartOptions {
+        hline: Some(0.0),
+        highlight_label: Some("unstable".into()),
+        ..ChartOptions::default()
+    };
+    let files = line_chart(
+        &stem,
+        "Stability map",
+        "frequency (Hz)",
+        "real part (1/s)",
+        &[modes(), curve()],
+        &opts,
+    )
+    .unwrap();
+    let svg = check_outputs(&stem, &files, CHART_SIZE);
+    // 3 normal markers (blue) + 2 highlighted (red); the Line series has no markers.
+    assert_eq!(svg.count("circle"), 5);
+    assert_eq!(svg.count_attr("circle", "fill", "#1F77B4"), 3);
+    assert_eq!(svg.count_attr("circle", "fill", "#D62728"), 2);
+    // The second series' line (orange).
+    assert_eq!(svg.count_attr("polyline", "stroke", "#FF7F0E"), 1);
+    for t in [
+        "Stability map",
+        "frequency (Hz)",
+        "real part (1/s)",
+        "modes",
+        "fit",
+        "unstable",
+    ] {
+        assert!(svg.has_text(t), "missing text {t:?} in {:?}", svg.texts());
+    }
+}
+
+#[test]
+fn line_chart_custom_size_and_line_markers() {
+    let dir = temp_dir("line-size");
+    let stem = dir.join("conv");
+    let s = Series {
+        name: String::new(), // no legend
+        points: (0..8).map(|i| (i as f64, 10f64.powi(-i))).collect(),
+        style: SeriesStyle::LineMarkers,
+        highlight: vec![],
+    };
+    let opts = ChartOptions {
+        log_y: true,
+        size: (640, 480),
+        ..ChartOptions::default()
+    };
+    let files = line_chart(&stem, "Convergence", "iteration", "error (-)", &[s], &opts).unwrap();
+    let svg = check_outputs(&stem, &files, (640, 480));
+    assert_eq!(svg.count("circle"), 8);
+    assert_eq!(svg.count_attr("polyline", "stroke", "#1F77B4"), 1);
+    assert!(svg.has_text("Convergence"));
+}
+
+#[test]
+fn line_chart_log_axes_drop_non_positive_points() {
+    let dir = temp_dir("line-log");
+    let stem = dir.join("loglog");
+    let s = Series {
+        name: "s".into(),
+        points: vec![
+            (1.0, 1.0),
+            (10.0, 0.0),
+            (100.0, 1e-3),
+            (-1.0, 5.0),
+            (1e3, -2.0),
+        ],
+        style: SeriesStyle::Markers,
+        highlight: vec![false, true, false, false, true],
+    };
+    let opts = ChartOptions {
+        log_x: true,
+        log_y: true,
+        hline: Some(0.0), // not drawable on a log axis: ignored
+        ..ChartOptions::default()
+    };
+    let files = line_chart(
+        &stem,
+        "log",
+        "x (-)",
+        "y (-)",
+        std::slice::from_ref(&s),
+        &opts,
+    )
+    .unwrap();
+    let svg = check_outputs(&stem, &files, CHART_SIZE);
+    assert_eq!(svg.count("circle"), 2, "only (1, 1) and (100, 1e-3) remain");
+    assert_eq!(svg.count_attr("circle", "fill", "#D62728"), 0);
+
+    // Nothing positive left: empty.
+    let bad = Series {
+        points: vec![(0.0, 1.0), (-3.0, 2.0)],
+        highlight: vec![],
+        ..s
+    };
+    let stem2 = dir.join("none");
+    let err = line_chart(&stem2, "log", "x", "y", &[bad], &opts).unwrap_err();
+    assert!(matches!(err, PlotError::EmptyData { .. }), "{err}");
+    assert_names(&err, &stem2);
+}
+
+#[test]
+fn line_chart_bad_input() {
+    let dir = temp_dir("line-bad");
+    let stem = dir.join("c");
+    let o = ChartOptions::default();
+    let err = line_chart(&stem, "t", "x", "y", &[], &o).unwrap_err();
+    assert!(matches!(err, PlotError::EmptyData { .. }), "{err}");
+    assert_names(&err, &stem);
+    let empty = Series::default();
+    let err = line_chart(&stem, "t", "x", "y", &[empty], &o).unwrap_err();
+    assert!(matches!(err, PlotError::EmptyData { .. }), "{err}");
+
+    let mut nan = modes();
+    nan.points[2].1 = f64::NAN;
+    let err = line_chart(&stem, "t", "x", "y", &[nan], &o).unwrap_err();
+    assert!(matches!(err, PlotError::NanData { .. }), "{err}");
+    assert_names(&err, &stem);
+
+    let mut mask = modes();
+    mask.highlight.pop();
+    let err = line_chart(&stem, "t", "x", "y", &[mask], &o).unwrap_err();
+    assert!(matches!(err, PlotError::InvalidInput { .. }), "{err}");
+
+    let inverted = ChartOptions {
+        x_range: Some((5.0, 1.0)),
+        ..ChartOptions::default()
+    };
+    let err = line_chart(&stem, "t", "x", "y", &[modes()], &inverted).unwrap_err();
+    assert!(matches!(err, PlotError::InvalidInput { .. }), "{err}");
+    assert_names(&err, &stem);
+}
+
+// --------------------------------------------------------------------------- pareto
+
+fn methods() -> Vec<(String, f64, f64)> {
+    [
+        ("dense", 80.0, 1e-13),   // front
+        ("modes", 0.5, 1e-3),     // front
+        ("big modes", 2.0, 1e-2), // dominated by modes
+        ("enriched", 1.5, 1e-6),  // front
+        ("krylov", 90.0, 1e-12),  // dominated by dense
+    ]
+    .into_iter()
+    .map(|(l, t, e)| (l.to_string(), t, e))
+    .collect()
+}
+
+#[test]
+fn pareto_front_selection() {
+    let pts: Vec<(f64, f64)> = methods().iter().map(|m| (m.1, m.2)).collect();
+    assert_eq!(pareto_front(&pts), vec![1, 3, 0]);
+    assert_eq!(pareto_front(&[(1.0, 1.0)]), vec![0]);
+    assert_eq!(pareto_front(&[(1.0, 2.0), (2.0, 1.0)]), vec![0, 1]);
+    assert_eq!(pareto_front(&[(2.0, 2.0), (1.0, 2.0)]), vec![1]);
+    assert_eq!(pareto_front(&[(2.0, 2.0), (2.0, 1.0)]), vec![1]);
+}
+
+#[test]
+fn pareto_chart_marks_front_and_labels() {
+    let dir = temp_dir("pareto");
+    let stem = dir.join("pareto");
+    let mut pts = methods();
+    pts.push(("free lunch?".into(), 0.0, 1e-3)); // not on a log axis: dropped
+    let files = pareto_chart(&stem, "Pareto title", "time (s)", "error (-)", &pts).unwrap();
+    let svg = check_outputs(&stem, &files, CHART_SIZE);
+    // 3 front points (red, radius 6) + 2 dominated (blue), + one legend circle each.
+    assert_eq!(svg.count_attr("circle", "fill", "#D62728"), 3 + 1);
+    assert_eq!(svg.count_attr("circle", "fill", "#1F77B4"), 2 + 1);
+    assert_eq!(
+        svg.count_attr("polyline", "stroke", "#D62728"),
+        1,
+        "front line"
+    );
+    for (l, _, _) in &methods() {
+        assert!(svg.has_text(l), "missing label {l}");
+    }
+    assert!(!svg.has_text("free lunch?"));
+    assert!(svg.has_text("Pareto title") && svg.has_text("Pareto front"));
+}
+
+#[test]
+fn pareto_chart_bad_input() {
+    let dir = temp_dir("pareto-bad");
+    let stem = dir.join("p");
+    let err = pareto_chart(&stem, "t", "x", "y", &[]).unwrap_err();
+    assert!(matches!(err, PlotError::EmptyData { .. }), "{err}");
+    assert_names(&err, &stem);
+    let err = pareto_chart(&stem, "t", "x", "y", &[("a".into(), -1.0, 1.0)]).unwrap_err();
+    assert!(matches!(err, PlotError::EmptyData { .. }), "{err}");
+    let mut pts = methods();
+    pts[1].2 = f64::NAN;
+    let err = pareto_chart(&stem, "t", "x", "y", &pts).unwrap_err();
+    assert!(matches!(err, PlotError::NanData { .. }), "{err}");
+    assert_names(&err, &stem);
+}
+
+// --------------------------------------------------------------------------- bars
+
+#[test]
+fn bar_chart_one_rect_per_bar() {
+    let dir = temp_dir("bars");
+    let stem = dir.join("timings");
+    let bars: Vec<(String, f64)> = [
+        ("assembly", 1.5),
+        ("factor", 4.0),
+        ("eigen", 2.25),
+        ("loss", -0.5),
+    ]
+    .into_iter()
+    .map(|(l, v)| (l.to_string(), v))
+    .collect();
+    let files = bar_chart(&stem, "Bar title", "stage", "time (s)", &bars).unwrap();
+    let svg = check_outputs(&stem, &files, CHART_SIZE);
+    assert_eq!(svg.count_attr("rect", "fill", "#1F77B4"), bars.len());
+    assert!(svg.count("rect") >= bars.len());
+    for (l, v) in &bars {
+        assert!(svg.has_text(l), "missing label {l}");
+        assert!(svg.has_text(&format!("{v}")), "missing value {v}");
+    }
+    assert!(svg.has_text("Bar title") && svg.has_text("time (s)"));
+}
+
+#[test]
+fn bar_chart_bad_input() {
+    let dir = temp_dir("bars-bad");
+    let stem = dir.join("b");
+    let err = bar_chart(&stem, "t", "x", "y", &[]).unwrap_err();
+    assert!(matches!(err, PlotError::EmptyData { .. }), "{err}");
+    assert_names(&err, &stem);
+    let err = bar_chart(&stem, "t", "x", "y", &[("a".into(), f64::NAN)]).unwrap_err();
+    assert!(matches!(err, PlotError::NanData { .. }), "{err}");
+    assert_names(&err, &stem);
+}
+
+#[test]
+fn unwritable_output_is_an_io_error_naming_the_path() {
+    let dir = temp_dir("io");
+    // A regular file where the output directory should be.
+    let blocker = dir.join("not-a-dir");
+    std::fs::write(&blocker, b"x").unwrap();
+    let stem = blocker.join("out");
+    let err = bar_chart(&stem, "t", "x", "y", &[("a".into(), 1.0)]).unwrap_err();
+    assert!(matches!(err, PlotError::Io { .. }), "{err}");
+    assert!(
+        err.to_string().contains(&blocker.display().to_string()),
+        "{err}"
+    );
+}
