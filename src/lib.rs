@@ -20,5 +20,6 @@ pub fn registry() -> Registry {
     squeal_equilibrium_lcp::register(&mut reg);
     squeal_eigen_arpack::register(&mut reg);
     squeal_eigen_krylov::register(&mut reg);
+    squeal_eigen_dense::register(&mut reg);
     reg
 }

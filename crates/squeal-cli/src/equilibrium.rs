@@ -184,13 +184,45 @@ pub fn run(
     };
     let path = out.join("equilibrium.json");
     std::fs::write(&path, json).with_context(|| format!("writing {}", path.display()))?;
+    let grid = setup.model.contact.as_ref().expect("a contact set has a grid");
+    let cell = [grid.xs[1] - grid.xs[0], grid.ys[1] - grid.ys[0]];
+    let panels: Vec<squeal_plot::MapPanel> = eqs
+        .iter()
+        .map(|eq| squeal_plot::MapPanel {
+            title: format!(
+                "mu = {} ({} of {} pairs)",
+                eq.eq.mu,
+                eq.eq.active.iter().filter(|&&a| a).count(),
+                setup.set.len()
+            ),
+            xy: setup.set.xy.clone(),
+            values: eq.eq.rn.clone(),
+            cell,
+            arrow: Some([dir[0], dir[1]]),
+            arrow_label: "disc sliding".into(),
+        })
+        .collect();
+    squeal_plot::contact_map(
+        &out.join("contact_map"),
+        &format!(
+            "Normal contact force per pair, {} N total ({solver}, {law})",
+            setup.scene.load.normal_force_n.map_or("imposed-displacement".to_string(), |f| format!("{f}"))
+        ),
+        "Rn (N)",
+        &panels,
+    )
+    .context("contact force map")?;
     let _ = start;
     Ok(reports)
 }
 
 /// Output paths written by [`run`] besides the charts.
 pub fn outputs(out: &Path, reports: &[EquilibriumReport]) -> Vec<PathBuf> {
-    let mut v = vec![out.join("equilibrium.json")];
+    let mut v = vec![
+        out.join("equilibrium.json"),
+        out.join("contact_map.svg"),
+        out.join("contact_map.png"),
+    ];
     v.extend(reports.iter().map(|r| out.join(&r.csv)));
     v
 }

@@ -230,8 +230,25 @@ pub fn solve_symmetric_band(
         }
     };
     info.op_applications = op.applications();
+    let mut modes = finish_real_modes(problem, &omega2, vectors.as_ref(), params, info);
+    modes.info.time_s = start.elapsed().as_secs_f64();
+    Ok(modes)
+}
 
-    // Normalize, compute residuals, keep the band, sort.
+/// Finishing step shared by every symmetric backend: keeps the pairs with
+/// `omega^2 <= (2 pi fmax)^2` (and `>= (2 pi fmin)^2` when `fmin > 0`), `M`-normalizes the
+/// vectors, computes the relative residuals (module docs) and sorts by frequency.
+/// `info` is passed through unchanged (the caller sets `time_s`).
+pub fn finish_real_modes(
+    problem: &SymmetricProblem<'_>,
+    omega2: &[f64],
+    vectors: faer::MatRef<'_, f64>,
+    params: &EigenParams,
+    info: SolveInfo,
+) -> RealModes {
+    let n = problem.k.nrows();
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let top = (two_pi * params.fmax_hz).powi(2);
     let kn = norm1(problem.k);
     let mn = norm1(problem.m);
     let bottom = (two_pi * params.fmin_hz).powi(2);
@@ -262,17 +279,17 @@ pub fn solve_symmetric_band(
     }
     let omega2: Vec<f64> = keep.iter().map(|p| p.0).collect();
     let freq_hz = omega2.iter().map(|&l| l.max(0.0).sqrt() / two_pi).collect();
-    info.time_s = start.elapsed().as_secs_f64();
-    Ok(RealModes {
+    RealModes {
         omega2,
         freq_hz,
         vectors: out_vec,
         residuals,
         info,
-    })
+    }
 }
 
-fn validate_params(p: &EigenParams) -> Result<()> {
+/// Checks the band (`0 <= fmin < fmax`, finite, in Hz) and the tolerance (`0 < tol < 1`).
+pub fn validate_params(p: &EigenParams) -> Result<()> {
     if !(p.fmax_hz.is_finite() && p.fmax_hz > 0.0) {
         return Err(Error::param(
             "fmax_hz",

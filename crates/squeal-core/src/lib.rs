@@ -31,7 +31,10 @@ pub use eigen::{
 pub use error::{Error, Result};
 pub use material::{Material, Voigt6};
 pub use params::{ParamValue, Params};
-pub use qep::{ComplexKernel, ComplexKernelOutput, ComplexLinOp, ComplexModes, Qep};
+pub use qep::{
+    dense_qep, solve_qep_band, ComplexKernel, ComplexKernelOutput, ComplexLinOp, ComplexModes, Qep,
+    QepShiftInvert, QepSymbolic,
+};
 pub use registry::Registry;
 
 pub use faer;

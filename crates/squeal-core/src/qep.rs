@@ -16,9 +16,19 @@
 //! `eta = ||Q(lambda) u|| / ((|lambda|^2 ||M~|| + |lambda| ||C~|| + ||K~||) ||u||)`
 //! (1-norms of the matrices, 2-norm of the vectors).
 
-use crate::eigen::{EigenParams, SolveInfo};
-use crate::{c64, Error, Result, SparseMat};
-use faer::Mat;
+use crate::contact::FrictionalOperator;
+use crate::eigen::{validate_params, EigenParams, SolveInfo, StopReason};
+use crate::linalg::{check_square_finite, norm1};
+use crate::{c64, Error, Result, SparseMat, SparseRef};
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, Triplet};
+use faer::{Mat, MatMut};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+#[cfg(test)]
+mod tests;
 
 /// One quadratic eigenproblem `(lambda^2 M + lambda C + K) u = 0` (one mu, one contact set).
 #[derive(Debug, Clone)]
@@ -104,27 +114,253 @@ pub trait ComplexKernel: Send + Sync {
     ) -> Result<ComplexKernelOutput>;
 }
 
+/// Relative size of `Im(lambda)` below which a root counts as real (not an oscillating
+/// mode): `|Im(lambda)| <= REAL_ROOT_REL |lambda|`. Such roots are dropped by
+/// [`finish_modes`].
+pub const REAL_ROOT_REL: f64 = 1e-10;
+
+/// Roots of the scaled companion form (see [`dense_qep`]) with `|mu| <= RIGID_BODY_REL`,
+/// i.e. `|lambda| <= RIGID_BODY_REL sqrt(||K|| / ||M||)`, are rigid-body roots: a zero
+/// eigenvalue of a defective pencil is computed as `O(sqrt(eps))` (often a tiny
+/// imaginary pair); [`dense_qep`] returns them as exact zeros.
+pub const RIGID_BODY_REL: f64 = 1e-6;
+
+/// Checks that `M`, `C` and `K` are square of the same size with finite entries.
+pub fn check_qep(qep: &Qep) -> Result<()> {
+    let n = qep.dim();
+    check_square_finite(qep.k.as_ref(), n, "K~")?;
+    check_square_finite(qep.m.as_ref(), n, "M~")?;
+    if let Some(c) = &qep.c {
+        check_square_finite(c.as_ref(), n, "C~")?;
+    }
+    Ok(())
+}
+
+/// `y = A x` for a real sparse matrix and a complex vector (overwrites `y`).
+pub fn spmv_complex(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
+    y.iter_mut().for_each(|v| *v = c64::new(0.0, 0.0));
+    spmv_complex_add(a, x, y);
+}
+
+/// `y += A x` for a real sparse matrix and a complex vector.
+fn spmv_complex_add(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
+    debug_assert_eq!(x.len(), a.ncols());
+    debug_assert_eq!(y.len(), a.nrows());
+    for j in 0..a.ncols() {
+        let xj = x[j];
+        if xj.re == 0.0 && xj.im == 0.0 {
+            continue;
+        }
+        for (i, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
+            y[i] += xj * *v;
+        }
+    }
+}
+
+fn norm2_c(x: &[c64]) -> f64 {
+    x.iter()
+        .map(|v| v.re * v.re + v.im * v.im)
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// Symbolic sparse LU analysis of `Q(sigma) = sigma^2 M + sigma C + K` on the union of
+/// the patterns of the matrices it was built from. Build it once and pass it to
+/// [`QepShiftInvert::with_symbolic`] for every shift; built with
+/// [`for_operator`](Self::for_operator) it also serves every `mu` of one contact set.
+#[derive(Debug, Clone)]
+pub struct QepSymbolic {
+    pattern: SymbolicSparseColMat<usize>,
+    lu: SymbolicLu<usize>,
+}
+
+impl QepSymbolic {
+    /// Analysis of the union pattern of `M`, `C` and `K` of `qep`.
+    pub fn new(qep: &Qep) -> Result<Self> {
+        let mut mats = vec![qep.m.as_ref(), qep.k.as_ref()];
+        if let Some(c) = &qep.c {
+            mats.push(c.as_ref());
+        }
+        Self::from_patterns(qep.dim(), &mats)
+    }
+
+    /// Analysis of the union pattern of every part of a frictional operator: valid for
+    /// [`op.at(mu)`](FrictionalOperator::at) at any `mu`.
+    pub fn for_operator(op: &FrictionalOperator) -> Result<Self> {
+        let mut mats = vec![
+            op.mc.as_ref(),
+            op.kc.as_ref(),
+            op.fm.as_ref(),
+            op.fk.as_ref(),
+        ];
+        for c in [&op.cc, &op.fc].into_iter().flatten() {
+            mats.push(c.as_ref());
+        }
+        Self::from_patterns(op.dim(), &mats)
+    }
+
+    /// Analysis of the union pattern of `mats` (each `n x n`).
+    pub fn from_patterns(n: usize, mats: &[SparseRef<'_>]) -> Result<Self> {
+        let mut trip = Vec::with_capacity(mats.iter().map(|a| a.compute_nnz()).sum::<usize>() + n);
+        for (k, a) in mats.iter().enumerate() {
+            if a.nrows() != n || a.ncols() != n {
+                return Err(Error::Dimension {
+                    context: format!("QepSymbolic: matrix {k} must be {n} x {n}"),
+                    expected: n,
+                    got: if a.nrows() != n { a.nrows() } else { a.ncols() },
+                });
+            }
+            for j in 0..n {
+                trip.extend(a.row_idx_of_col(j).map(|i| Triplet::new(i, j, 1.0)));
+            }
+        }
+        // The diagonal is always kept: a structurally zero diagonal entry of the union
+        // would still be a legitimate pivot position for some shift.
+        trip.extend((0..n).map(|i| Triplet::new(i, i, 1.0)));
+        let pattern = SparseMat::try_new_from_triplets(n, n, &trip)
+            .map_err(|e| Error::Invalid(format!("QepSymbolic: {e:?}")))?
+            .into_parts()
+            .0;
+        let lu = SymbolicLu::try_new(pattern.as_ref()).map_err(|e| Error::Factorization {
+            what: format!("Q(sigma) = sigma^2 M + sigma C + K (symbolic, n = {n})"),
+            reason: format!("{e:?}"),
+        })?;
+        Ok(Self { pattern, lu })
+    }
+
+    /// Size of `Q`.
+    pub fn dim(&self) -> usize {
+        self.pattern.nrows()
+    }
+
+    /// Stored entries of the union pattern.
+    pub fn nnz(&self) -> usize {
+        self.pattern.compute_nnz()
+    }
+
+    /// Values of `Q(sigma)` on the union pattern.
+    fn assemble(&self, qep: &Qep, sigma: c64) -> Result<Vec<c64>> {
+        let n = self.dim();
+        if qep.dim() != n {
+            return Err(Error::Dimension {
+                context: "QepShiftInvert: the symbolic analysis was built for another size".into(),
+                expected: n,
+                got: qep.dim(),
+            });
+        }
+        let pat = self.pattern.as_ref();
+        let mut vals = vec![c64::new(0.0, 0.0); pat.compute_nnz()];
+        let mut slot = vec![usize::MAX; n];
+        let mut parts: Vec<(SparseRef<'_>, c64, &str)> = vec![
+            (qep.m.as_ref(), sigma * sigma, "M"),
+            (qep.k.as_ref(), c64::new(1.0, 0.0), "K"),
+        ];
+        if let Some(c) = &qep.c {
+            parts.push((c.as_ref(), sigma, "C"));
+        }
+        for j in 0..n {
+            let range = pat.col_range(j);
+            for (p, &i) in range.clone().zip(pat.row_idx_of_col_raw(j)) {
+                slot[i] = p;
+            }
+            for (a, s, name) in &parts {
+                for (i, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
+                    let p = slot[i];
+                    if p == usize::MAX {
+                        return Err(Error::Invalid(format!(
+                            "QepShiftInvert: entry ({i}, {j}) of {name} lies outside the \
+                             pattern of the symbolic analysis (built for another operator?)"
+                        )));
+                    }
+                    vals[p] += *s * *v;
+                }
+            }
+            for &i in pat.row_idx_of_col_raw(j) {
+                slot[i] = usize::MAX;
+            }
+        }
+        Ok(vals)
+    }
+}
+
 /// Shift-invert of the companion form at a complex shift `sigma`:
 /// `OP = (A - sigma B)^-1 B` with `A = [0 I; -K -C]`, `B = [I 0; 0 M]`, applied through one
 /// sparse LU of `Q(sigma) = sigma^2 M + sigma C + K`:
 /// `x1 = -Q^-1 [b2 + (C + sigma M) b1]`, `x2 = b1 + sigma x1` where `b = B x`.
 /// Eigenvalues map back as `lambda = sigma + 1/theta`.
+///
+/// Derivation: `(A - sigma B) x = b` reads `-sigma x1 + x2 = b1` and
+/// `-K x1 - (C + sigma M) x2 = b2`; substituting the first into the second gives
+/// `-(sigma^2 M + sigma C + K) x1 = b2 + (C + sigma M) b1`. An eigenvector of `OP` is a
+/// companion eigenvector `z = [u; lambda u]`, so its first `n` components are the mode `u`.
 pub struct QepShiftInvert<'a> {
     qep: &'a Qep,
     sigma: c64,
-    #[allow(dead_code)]
-    lu: Option<faer::sparse::linalg::solvers::Lu<usize, c64>>,
+    lu: Lu<usize, c64>,
+    applications: AtomicUsize,
 }
 
 impl<'a> QepShiftInvert<'a> {
-    /// Factorizes `Q(sigma)`.
+    /// Factorizes `Q(sigma)` (symbolic analysis included).
     pub fn new(qep: &'a Qep, sigma: c64) -> Result<Self> {
-        let _ = (qep, sigma);
-        Err(Error::Unsupported {
-            plugin: "squeal-core".into(),
-            operation: "QepShiftInvert (not implemented yet)".into(),
+        check_qep(qep)?;
+        let sym = QepSymbolic::new(qep)?;
+        Self::with_symbolic_unchecked(qep, sigma, &sym)
+    }
+
+    /// Factorizes `Q(sigma)` reusing a symbolic analysis (same pattern, any shift).
+    pub fn with_symbolic(qep: &'a Qep, sigma: c64, symbolic: &QepSymbolic) -> Result<Self> {
+        check_qep(qep)?;
+        Self::with_symbolic_unchecked(qep, sigma, symbolic)
+    }
+
+    fn with_symbolic_unchecked(qep: &'a Qep, sigma: c64, symbolic: &QepSymbolic) -> Result<Self> {
+        let n = qep.dim();
+        if !(sigma.re.is_finite() && sigma.im.is_finite()) {
+            return Err(Error::param(
+                "sigma",
+                format!("shift must be finite, got {sigma}"),
+            ));
+        }
+        let vals = symbolic.assemble(qep, sigma)?;
+        let q = SparseColMatRef::new(symbolic.pattern.as_ref(), &vals);
+        let what = || {
+            format!(
+                "Q(sigma) = sigma^2 M + sigma C + K (sigma = {:.6e}{:+.6e}i rad/s, n = {n})",
+                sigma.re, sigma.im
+            )
+        };
+        let lu = Lu::try_new_with_symbolic(symbolic.lu.clone(), q).map_err(|e| {
+            Error::Factorization {
+                what: what(),
+                reason: format!("{e:?}"),
+            }
+        })?;
+        // A singular Q(sigma) (sigma on an eigenvalue) shows up as non-finite solves.
+        let probe: Vec<c64> = (0..n)
+            .map(|i| c64::new(1.0 + 0.1 * (i as f64).sin(), 0.0))
+            .collect();
+        let mut y = vec![c64::new(0.0, 0.0); n];
+        for j in 0..n {
+            for (p, &i) in q.col_range(j).zip(q.symbolic().row_idx_of_col_raw(j)) {
+                y[i] += vals[p] * probe[j];
+            }
+        }
+        lu.solve_in_place(MatMut::from_column_major_slice_mut(&mut y, n, 1));
+        if y.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
+            return Err(Error::Factorization {
+                what: what(),
+                reason: "numerically singular (is sigma an eigenvalue?)".into(),
+            });
+        }
+        Ok(Self {
+            qep,
+            sigma,
+            lu,
+            applications: AtomicUsize::new(0),
         })
     }
+
     /// The shift.
     pub fn sigma(&self) -> c64 {
         self.sigma
@@ -137,44 +373,506 @@ impl<'a> QepShiftInvert<'a> {
     pub fn lambda_of_theta(&self, theta: c64) -> c64 {
         self.sigma + c64::new(1.0, 0.0) / theta
     }
+    /// How many times the operator was applied (one sparse solve each).
+    pub fn applications(&self) -> usize {
+        self.applications.load(Ordering::Relaxed)
+    }
+    /// `y <- Q(sigma)^-1 y` (length `n`, not counted as an application).
+    pub fn solve_in_place(&self, y: &mut [c64]) {
+        let n = y.len();
+        self.lu
+            .solve_in_place(MatMut::from_column_major_slice_mut(y, n, 1));
+    }
+}
+
+impl ComplexLinOp for QepShiftInvert<'_> {
+    fn dim(&self) -> usize {
+        2 * self.qep.dim()
+    }
+
+    fn apply(&self, x: &[c64], y: &mut [c64]) {
+        let n = self.qep.dim();
+        assert_eq!(
+            x.len(),
+            2 * n,
+            "QepShiftInvert::apply: x has the wrong length"
+        );
+        assert_eq!(
+            y.len(),
+            2 * n,
+            "QepShiftInvert::apply: y has the wrong length"
+        );
+        let (x1, x2) = x.split_at(n);
+        let (y1, y2) = y.split_at_mut(n);
+        // r = M x2 + (C + sigma M) x1 = M (x2 + sigma x1) + C x1
+        let t: Vec<c64> = x2
+            .iter()
+            .zip(x1)
+            .map(|(&a, &b)| a + self.sigma * b)
+            .collect();
+        spmv_complex(self.qep.m.as_ref(), &t, y1);
+        if let Some(c) = &self.qep.c {
+            spmv_complex_add(c.as_ref(), x1, y1);
+        }
+        self.solve_in_place(y1);
+        for ((v1, v2), &b1) in y1.iter_mut().zip(y2.iter_mut()).zip(x1) {
+            *v1 = -*v1;
+            *v2 = b1 + self.sigma * *v1;
+        }
+        self.applications.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+/// Tuning of the band driver [`solve_qep_band_with`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct QepBandOptions {
+    /// Cap on `nev` of one Krylov run (also capped by `n - 2`); a window needing more is
+    /// split in two.
+    pub max_nev: usize,
+    /// Window radius `R = radius_factor * half_width + margin_rel * 2 pi f_top` (rad/s):
+    /// `radius_factor > 1` lets the circle reach past the band edges off the imaginary axis.
+    pub radius_factor: f64,
+    /// Extra radius as a fraction of the window's top angular frequency.
+    pub margin_rel: f64,
+    /// Maximum depth of window splitting (`2^max_depth` windows at most).
+    pub max_depth: usize,
+    /// First `nev` when [`EigenParams::nev_hint`] is `None`.
+    pub nev_default: usize,
+}
+
+impl Default for QepBandOptions {
+    fn default() -> Self {
+        Self {
+            max_nev: 400,
+            radius_factor: 1.05,
+            margin_rel: 0.01,
+            max_depth: 10,
+            nev_default: 24,
+        }
+    }
 }
 
 /// Band driver shared by the full-order complex backends: shifts `i 2 pi f` chosen to cover
 /// `[params.fmin_hz, params.fmax_hz]`, the kernel run on [`QepShiftInvert`] for each, `nev`
 /// grown until every window is covered, eigenvalues mapped back, duplicates merged, and the
 /// result finished by [`finish_modes`].
+///
+/// Same as [`solve_qep_band_with`] with default [`QepBandOptions`] and a fresh symbolic
+/// analysis.
 pub fn solve_qep_band(
     solver: &str,
     kernel: &dyn ComplexKernel,
     qep: &Qep,
     params: &EigenParams,
 ) -> Result<ComplexModes> {
-    let _ = (solver, kernel, qep, params);
-    Err(Error::Unsupported {
-        plugin: solver.into(),
-        operation: "solve_qep_band (not implemented yet)".into(),
-    })
+    solve_qep_band_with(
+        solver,
+        kernel,
+        qep,
+        params,
+        &QepBandOptions::default(),
+        None,
+    )
+}
+
+/// The band driver with explicit options and an optional reused symbolic analysis.
+///
+/// - Companion size `2n <= params.dense_below`: solved by [`dense_qep`] (noted in `info`).
+/// - Otherwise one window `[fmin, fmax]` to start with: shift `sigma = i 2 pi f_c` at its
+///   centre, radius `R` (see [`QepBandOptions`]). The kernel computes the `nev` largest
+///   `|theta|` of `OP`, i.e. the `nev` eigenvalues nearest `sigma`; once one of them lies
+///   outside the circle `|lambda - sigma| > R`, every eigenvalue inside it has been found.
+///   Until then `nev` doubles (from `params.nev_hint`, else `nev_default`); past the cap
+///   the window is split in two halves, recursively.
+/// - Each window keeps the eigenvalues with `Im > 0` and frequency in its sub-band;
+///   copies found by two windows are merged (relative distance `1e-8`, or 100 `tol R`).
+/// - The mode `u` is the first block of the companion eigenvector `z = [u; lambda u]`, or
+///   the second divided by `lambda` when that has the smaller backward error.
+/// - `params.shift_hz` is not used (the shifts are on the imaginary axis).
+pub fn solve_qep_band_with(
+    solver: &str,
+    kernel: &dyn ComplexKernel,
+    qep: &Qep,
+    params: &EigenParams,
+    options: &QepBandOptions,
+    symbolic: Option<&QepSymbolic>,
+) -> Result<ComplexModes> {
+    let start = Instant::now();
+    validate_params(params)?;
+    check_qep(qep)?;
+    let n = qep.dim();
+    if n == 0 {
+        return Err(Error::Invalid("empty quadratic eigenproblem".into()));
+    }
+    let valid = options.radius_factor.is_finite()
+        && options.radius_factor >= 1.0
+        && options.margin_rel.is_finite()
+        && options.margin_rel >= 0.0;
+    if options.max_nev == 0 || !valid {
+        return Err(Error::param(
+            "qep band options",
+            format!("need max_nev >= 1, radius_factor >= 1, margin_rel >= 0; got {options:?}"),
+        ));
+    }
+    let mut info = SolveInfo {
+        solver: solver.to_string(),
+        time_s: 0.0,
+        requested: 0,
+        converged: 0,
+        iterations: 0,
+        op_applications: 0,
+        factorizations: 0,
+        reason: StopReason::Converged,
+        notes: Vec::new(),
+    };
+    if 2 * n <= params.dense_below {
+        info.notes.push(format!(
+            "companion size 2n = {} <= {}: solved densely instead of `{solver}`",
+            2 * n,
+            params.dense_below
+        ));
+        let (lambda, vectors) = dense_qep(qep)?;
+        info.requested = lambda.len();
+        info.converged = lambda.len();
+        let mut modes = finish_modes(qep, &lambda, vectors.as_ref(), params, info)?;
+        modes.info.time_s = start.elapsed().as_secs_f64();
+        return Ok(modes);
+    }
+    let owned;
+    let sym = match symbolic {
+        Some(s) => s,
+        None => {
+            owned = QepSymbolic::new(qep)?;
+            &owned
+        }
+    };
+    let cap = options.max_nev.min(n.saturating_sub(2)).max(1);
+    let mut run = BandRun {
+        kernel,
+        qep,
+        params,
+        options,
+        sym,
+        cap,
+        norms: QepNorms::of(qep),
+        info,
+        lambda: Vec::new(),
+        vectors: Vec::new(),
+    };
+    let nev0 = params.nev_hint.unwrap_or(options.nev_default).clamp(1, cap);
+    run.window(params.fmin_hz, params.fmax_hz, 0, nev0)?;
+    let mut vectors = Mat::<c64>::zeros(n, run.lambda.len());
+    for (c, v) in run.vectors.iter().enumerate() {
+        for r in 0..n {
+            vectors[(r, c)] = v[r];
+        }
+    }
+    let mut modes = finish_modes(qep, &run.lambda, vectors.as_ref(), params, run.info)?;
+    modes.info.time_s = start.elapsed().as_secs_f64();
+    Ok(modes)
+}
+
+/// State of one band solve: what is fixed and what has been collected so far.
+struct BandRun<'a> {
+    kernel: &'a dyn ComplexKernel,
+    qep: &'a Qep,
+    params: &'a EigenParams,
+    options: &'a QepBandOptions,
+    sym: &'a QepSymbolic,
+    cap: usize,
+    norms: QepNorms,
+    info: SolveInfo,
+    lambda: Vec<c64>,
+    vectors: Vec<Vec<c64>>,
+}
+
+impl BandRun<'_> {
+    /// Covers `[lo, hi]` Hz with one shift, or splits it.
+    fn window(&mut self, lo: f64, hi: f64, depth: usize, nev0: usize) -> Result<()> {
+        let n = self.qep.dim();
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let sigma = c64::new(0.0, two_pi * 0.5 * (lo + hi));
+        let half = two_pi * 0.5 * (hi - lo);
+        let radius = self.options.radius_factor * half + self.options.margin_rel * two_pi * hi;
+        let op = QepShiftInvert::with_symbolic(self.qep, sigma, self.sym)?;
+        self.info.factorizations += 1;
+        let mut nev = nev0.clamp(1, self.cap);
+        let outcome = loop {
+            let out = self
+                .kernel
+                .largest(&op, nev, self.params.tol, self.params.max_restarts)?;
+            if out.vectors.nrows() != 2 * n || out.vectors.ncols() < out.theta.len() {
+                return Err(Error::Dimension {
+                    context: format!(
+                        "complex kernel returned {} x {} vectors for {} eigenvalues",
+                        out.vectors.nrows(),
+                        out.vectors.ncols(),
+                        out.theta.len()
+                    ),
+                    expected: 2 * n,
+                    got: out.vectors.nrows(),
+                });
+            }
+            self.info.iterations += out.iterations;
+            self.info.requested = nev;
+            self.info.converged = out.theta.len();
+            let lam: Vec<c64> = out.theta.iter().map(|&t| op.lambda_of_theta(t)).collect();
+            let reach = lam
+                .iter()
+                .filter(|l| l.re.is_finite() && l.im.is_finite())
+                .map(|&l| (l - sigma).norm())
+                .fold(0.0, f64::max);
+            if !out.all_converged {
+                self.info.reason = StopReason::MaxIterations;
+                self.info.notes.push(format!(
+                    "window [{lo:.6e}, {hi:.6e}] Hz: only {} of {nev} pairs converged",
+                    out.theta.len()
+                ));
+                break Some((out, lam));
+            }
+            if reach > radius {
+                break Some((out, lam));
+            }
+            if nev >= self.cap {
+                if depth < self.options.max_depth {
+                    self.info.notes.push(format!(
+                        "window [{lo:.6e}, {hi:.6e}] Hz: {nev} pairs reach only \
+                         |lambda - sigma| = {reach:.4e} < R = {radius:.4e}; split in two"
+                    ));
+                    break None;
+                }
+                self.info.reason = StopReason::MaxIterations;
+                self.info.notes.push(format!(
+                    "window [{lo:.6e}, {hi:.6e}] Hz not covered: {nev} pairs reach only \
+                     |lambda - sigma| = {reach:.4e} < R = {radius:.4e} at the split depth limit"
+                ));
+                break Some((out, lam));
+            }
+            let grown = (2 * nev).min(self.cap);
+            self.info.notes.push(format!(
+                "window [{lo:.6e}, {hi:.6e}] Hz: {nev} pairs all inside R; retried with {grown}"
+            ));
+            nev = grown;
+        };
+        self.info.op_applications += op.applications();
+        drop(op);
+        let Some((out, lam)) = outcome else {
+            let mid = 0.5 * (lo + hi);
+            let next = (nev / 2).max(nev0).min(self.cap);
+            self.window(lo, mid, depth + 1, next)?;
+            return self.window(mid, hi, depth + 1, next);
+        };
+        // Keep this window's sub-band, merge copies found by earlier windows.
+        let before = self.lambda.len();
+        let mut matched = vec![false; before];
+        let slack = 1e-8 * hi;
+        for (k, &l) in lam.iter().enumerate() {
+            if !(l.re.is_finite() && l.im.is_finite()) || l.im <= 0.0 {
+                continue;
+            }
+            let f = l.im / two_pi;
+            if f < lo - slack || f > hi + slack {
+                continue;
+            }
+            let tol = (1e-8 * l.norm()).max(100.0 * self.params.tol * radius);
+            if let Some(p) =
+                (0..before).find(|&p| !matched[p] && (self.lambda[p] - l).norm() <= tol)
+            {
+                matched[p] = true;
+                continue;
+            }
+            // The companion eigenvector is z = [u; lambda u]: both blocks approximate u.
+            // The first is the documented choice; the second (divided by lambda) is kept
+            // when its backward error is smaller (its error is not amplified by |lambda|).
+            let u1: Vec<c64> = (0..n).map(|r| out.vectors[(r, k)]).collect();
+            let u2: Vec<c64> = (0..n).map(|r| out.vectors[(n + r, k)] / l).collect();
+            let (e1, e2) = (
+                backward_error_with(self.qep, &self.norms, l, &u1),
+                backward_error_with(self.qep, &self.norms, l, &u2),
+            );
+            self.lambda.push(l);
+            self.vectors.push(if e2 < e1 { u2 } else { u1 });
+        }
+        Ok(())
+    }
 }
 
 /// All eigenpairs of a small QEP, densely: companion form scaled by
 /// `gamma = sqrt(||K|| / ||M||)`, infinite and rigid-body roots filtered out.
 /// Returns every finite eigenvalue (both members of conjugate pairs) and its vector `u`.
+///
+/// Scaling (Fan, Lin & Van Dooren 2004): `lambda = gamma mu`, `delta = 2 / (||K|| +
+/// gamma ||C||)`, `M_s = gamma^2 delta M`, `C_s = gamma delta C`, `K_s = delta K`; the
+/// companion matrix `[0 I; -M_s^-1 K_s  -M_s^-1 C_s]` (one dense LU of `M_s`) is then
+/// diagonalized by faer's real non-symmetric `eigen` (no QZ). Non-finite roots are dropped;
+/// roots with `|mu| <= RIGID_BODY_REL` are returned as exact zeros (rigid-body motions;
+/// [`finish_modes`] drops them as non-oscillating). The vector is the first block of the
+/// companion eigenvector (`u`), or the second divided by `mu` when `|mu| > 1` (the better
+/// conditioned of the two). A singular `M` (massless DOFs) is an error. Cost: `O((2n)^3)`.
 pub fn dense_qep(qep: &Qep) -> Result<(Vec<c64>, Mat<c64>)> {
-    let _ = qep;
-    Err(Error::Unsupported {
-        plugin: "squeal-core".into(),
-        operation: "dense_qep (not implemented yet)".into(),
-    })
+    check_qep(qep)?;
+    let n = qep.dim();
+    if n == 0 {
+        return Ok((Vec::new(), Mat::zeros(0, 0)));
+    }
+    let kn = norm1(qep.k.as_ref());
+    let mn = norm1(qep.m.as_ref());
+    let cn = qep.c.as_ref().map_or(0.0, |c| norm1(c.as_ref()));
+    if mn == 0.0 {
+        return Err(Error::Invalid(
+            "dense QEP: the mass matrix M~ is zero (the companion form needs M~ invertible)".into(),
+        ));
+    }
+    let gamma = if kn > 0.0 { (kn / mn).sqrt() } else { 1.0 };
+    let denom = kn + gamma * cn;
+    let delta = if denom > 0.0 {
+        2.0 / denom
+    } else {
+        1.0 / (gamma * gamma * mn)
+    };
+    let ms = qep.m.as_ref().to_dense() * faer::Scale(gamma * gamma * delta);
+    let lu = ms.partial_piv_lu();
+    let u = lu.U();
+    let (mut pmin, mut pmax) = (f64::INFINITY, 0.0f64);
+    for i in 0..n {
+        let p = u[(i, i)].abs();
+        pmin = pmin.min(p);
+        pmax = pmax.max(p);
+    }
+    if pmin.is_nan() || pmin <= 1e-14 * pmax {
+        return Err(Error::Factorization {
+            what: format!("M~ (dense, n = {n})"),
+            reason: format!(
+                "singular mass matrix (pivot ratio {:.2e}): massless DOFs make infinite \
+                 eigenvalues; condense them out before the dense companion solve",
+                pmin / pmax
+            ),
+        });
+    }
+    // W = M_s^-1 [K_s | C_s]
+    let mut w = Mat::<f64>::zeros(n, 2 * n);
+    {
+        let kd = qep.k.as_ref().to_dense();
+        w.as_mut()
+            .submatrix_mut(0, 0, n, n)
+            .copy_from(kd * faer::Scale(delta));
+        if let Some(c) = &qep.c {
+            let cd = c.as_ref().to_dense();
+            w.as_mut()
+                .submatrix_mut(0, n, n, n)
+                .copy_from(cd * faer::Scale(gamma * delta));
+        }
+    }
+    lu.solve_in_place(w.as_mut());
+    let mut a = Mat::<f64>::zeros(2 * n, 2 * n);
+    for i in 0..n {
+        a[(i, n + i)] = 1.0;
+    }
+    for j in 0..2 * n {
+        for i in 0..n {
+            a[(n + i, j)] = -w[(i, j)];
+        }
+    }
+    if (0..2 * n).any(|j| (0..2 * n).any(|i| !a[(i, j)].is_finite())) {
+        return Err(Error::Factorization {
+            what: format!("M~ (dense, n = {n})"),
+            reason: "M~^-1 [K~ C~] is not finite: the mass matrix is numerically singular".into(),
+        });
+    }
+    let eig = faer::linalg::solvers::Eigen::new_from_real(a.as_ref()).map_err(|e| {
+        Error::NotConverged {
+            method: "dense non-symmetric eigen (companion form)".into(),
+            iterations: 0,
+            detail: format!("{e:?}"),
+        }
+    })?;
+    let s = eig.S();
+    let z = eig.U();
+    let mut lambda = Vec::with_capacity(2 * n);
+    let mut cols = Vec::with_capacity(2 * n);
+    for k in 0..2 * n {
+        let mu = s[k];
+        if !(mu.re.is_finite() && mu.im.is_finite()) {
+            continue;
+        }
+        let amu = mu.norm();
+        let l = if amu <= RIGID_BODY_REL {
+            c64::new(0.0, 0.0)
+        } else {
+            mu * gamma
+        };
+        lambda.push(l);
+        cols.push((k, mu, amu));
+    }
+    let mut vectors = Mat::<c64>::zeros(n, lambda.len());
+    for (c, &(k, mu, amu)) in cols.iter().enumerate() {
+        if amu > 1.0 {
+            let inv = c64::new(1.0, 0.0) / mu;
+            for r in 0..n {
+                vectors[(r, c)] = z[(n + r, k)] * inv;
+            }
+        } else {
+            for r in 0..n {
+                vectors[(r, c)] = z[(r, k)];
+            }
+        }
+    }
+    Ok((lambda, vectors))
+}
+
+/// The three norms entering the backward error.
+struct QepNorms {
+    m: f64,
+    c: f64,
+    k: f64,
+}
+
+impl QepNorms {
+    fn of(qep: &Qep) -> Self {
+        Self {
+            m: norm1(qep.m.as_ref()),
+            c: qep.c.as_ref().map_or(0.0, |c| norm1(c.as_ref())),
+            k: norm1(qep.k.as_ref()),
+        }
+    }
+}
+
+fn backward_error_with(qep: &Qep, norms: &QepNorms, lambda: c64, u: &[c64]) -> f64 {
+    let n = qep.dim();
+    assert_eq!(u.len(), n, "backward_error: vector of the wrong length");
+    // r = K u + lambda (C u + lambda M u)
+    let mut t = vec![c64::new(0.0, 0.0); n];
+    spmv_complex(qep.m.as_ref(), u, &mut t);
+    t.iter_mut().for_each(|v| *v *= lambda);
+    if let Some(c) = &qep.c {
+        spmv_complex_add(c.as_ref(), u, &mut t);
+    }
+    t.iter_mut().for_each(|v| *v *= lambda);
+    spmv_complex_add(qep.k.as_ref(), u, &mut t);
+    let num = norm2_c(&t);
+    let al = lambda.norm();
+    let den = (al * al * norms.m + al * norms.c + norms.k) * norm2_c(u);
+    if den > 0.0 {
+        num / den
+    } else if num == 0.0 {
+        0.0
+    } else {
+        f64::INFINITY
+    }
 }
 
 /// Backward error of `(lambda, u)` on `qep` (see module docs).
 pub fn backward_error(qep: &Qep, lambda: c64, u: &[c64]) -> f64 {
-    let _ = (qep, lambda, u);
-    f64::NAN
+    backward_error_with(qep, &QepNorms::of(qep), lambda, u)
 }
 
 /// Keeps the pairs with `Im(lambda) > 0` and frequency in the band, normalizes the vectors,
 /// computes frequencies, DvR and backward errors, and sorts by frequency.
+///
+/// Real roots (`|Im| <= REAL_ROOT_REL |lambda|`, rigid-body zeros included) are not
+/// oscillating modes and are dropped. The band is inclusive with a relative slack of
+/// `1e-12`. Vectors get unit 2-norm and a deterministic phase (their largest-modulus
+/// component real positive). `info` is passed through (the caller sets `time_s`).
 pub fn finish_modes(
     qep: &Qep,
     lambda: &[c64],
@@ -182,9 +880,69 @@ pub fn finish_modes(
     params: &EigenParams,
     info: SolveInfo,
 ) -> Result<ComplexModes> {
-    let _ = (qep, lambda, vectors, params, info);
-    Err(Error::Unsupported {
-        plugin: "squeal-core".into(),
-        operation: "finish_modes (not implemented yet)".into(),
+    let n = qep.dim();
+    if vectors.nrows() != n {
+        return Err(Error::Dimension {
+            context: "finish_modes: rows of the mode vectors".into(),
+            expected: n,
+            got: vectors.nrows(),
+        });
+    }
+    if vectors.ncols() != lambda.len() {
+        return Err(Error::Dimension {
+            context: "finish_modes: one vector per eigenvalue".into(),
+            expected: lambda.len(),
+            got: vectors.ncols(),
+        });
+    }
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let lo = params.fmin_hz * (1.0 - 1e-12);
+    let hi = params.fmax_hz * (1.0 + 1e-12);
+    let mut keep: Vec<(f64, usize)> = lambda
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.re.is_finite() && l.im.is_finite())
+        .filter(|(_, l)| l.im > REAL_ROOT_REL * l.norm())
+        .map(|(i, l)| (l.im / two_pi, i))
+        .filter(|&(f, _)| f >= lo && f <= hi)
+        .collect();
+    keep.sort_by(|a, b| {
+        a.0.total_cmp(&b.0)
+            .then(lambda[a.1].re.total_cmp(&lambda[b.1].re))
+    });
+    let norms = QepNorms::of(qep);
+    let mut out = Mat::<c64>::zeros(n, keep.len());
+    let (mut lam, mut freq, mut dvr, mut be) = (vec![], vec![], vec![], vec![]);
+    for (c, &(f, i)) in keep.iter().enumerate() {
+        let l = lambda[i];
+        let mut u: Vec<c64> = (0..n).map(|r| vectors[(r, i)]).collect();
+        let (mut p, mut big) = (0, 0.0);
+        for (r, v) in u.iter().enumerate() {
+            if v.norm() > big {
+                big = v.norm();
+                p = r;
+            }
+        }
+        let nrm = norm2_c(&u);
+        if big > 0.0 {
+            let phase = u[p].conj() / (big * nrm);
+            u.iter_mut().for_each(|v| *v *= phase);
+            u[p] = c64::new(u[p].norm(), 0.0);
+        }
+        be.push(backward_error_with(qep, &norms, l, &u));
+        for r in 0..n {
+            out[(r, c)] = u[r];
+        }
+        lam.push(l);
+        freq.push(f);
+        dvr.push(l.re / l.im);
+    }
+    Ok(ComplexModes {
+        lambda: lam,
+        vectors: out,
+        freq_hz: freq,
+        dvr,
+        backward_error: be,
+        info,
     })
 }
