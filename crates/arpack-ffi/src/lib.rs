@@ -214,8 +214,10 @@ extern "C" {
     /// Ritz values and vectors after [`znaupd_c`] (`zneupd`).
     ///
     /// `d`: `nev + 1` eigenvalues; `z`: `ldz * nev` vectors; `sigma`: the shift, passed
-    /// **by value** as a C `double _Complex`; `workev`: `2 ncv`; `select`: `ncv` integers.
-    /// The remaining arguments come unchanged from the [`znaupd_c`] run.
+    /// **by value** as a C `double _Complex`; `workev`: `2 ncv`; `select`: `ncv` integers;
+    /// `rwork`: `ncv` reals. The remaining arguments come unchanged from the [`znaupd_c`]
+    /// run. `zneupd` is stricter than `znaupd`: it requires `nev + 2 <= ncv <= n`
+    /// (`info = -3` otherwise), so size `ncv` for both.
     pub fn zneupd_c(
         rvec: a_int,
         howmny: *const c_char,

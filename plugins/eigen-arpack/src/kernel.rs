@@ -20,21 +20,24 @@ use squeal_core::Result;
 pub struct ArpackKernel;
 
 /// `a_int` from `usize`, or [`ArpackError::TooLarge`].
-fn to_int(what: &'static str, value: usize) -> Result<a_int, ArpackError> {
+pub(crate) fn to_int(what: &'static str, value: usize) -> Result<a_int, ArpackError> {
     a_int::try_from(value).map_err(|_| ArpackError::TooLarge { what, value })
 }
 
 /// The input `x = workd[ipntr[src]-1..][..n]` and output `y = workd[ipntr[dst]-1..][..n]`
-/// of a reverse-communication request (ARPACK's pointers are 1-based Fortran indices).
-fn request_io<'w>(
-    workd: &'w mut [f64],
+/// of a reverse-communication request of `routine` (ARPACK's pointers are 1-based
+/// Fortran indices, counted in elements of `T`: `f64` or complex).
+pub(crate) fn request_io<'w, T>(
+    routine: Routine,
+    workd: &'w mut [T],
     ipntr: &[a_int],
     src: usize,
     dst: usize,
     ido: a_int,
     n: usize,
-) -> Result<(&'w [f64], &'w mut [f64]), ArpackError> {
+) -> Result<(&'w [T], &'w mut [T]), ArpackError> {
     let bad = || ArpackError::BadPointers {
+        routine,
         ido,
         ipntr: [ipntr[0], ipntr[1], ipntr[2]],
         n,
@@ -135,17 +138,17 @@ fn run(
         match ido {
             // y = OP x = (K - sigma M)^-1 M x, B x not available (initialization).
             -1 => {
-                let (x, y) = request_io(&mut workd, &ipntr, 0, 1, ido, n)?;
+                let (x, y) = request_io(Routine::Dsaupd, &mut workd, &ipntr, 0, 1, ido, n)?;
                 op.apply(x, y);
             }
             // y = OP x with B x = M x already at workd[ipntr[2]-1..].
             1 => {
-                let (mx, y) = request_io(&mut workd, &ipntr, 2, 1, ido, n)?;
+                let (mx, y) = request_io(Routine::Dsaupd, &mut workd, &ipntr, 2, 1, ido, n)?;
                 op.apply_with_mx(mx, y);
             }
             // y = B x = M x.
             2 => {
-                let (x, y) = request_io(&mut workd, &ipntr, 0, 1, ido, n)?;
+                let (x, y) = request_io(Routine::Dsaupd, &mut workd, &ipntr, 0, 1, ido, n)?;
                 op.m_mul(x, y);
             }
             99 => break,
@@ -155,7 +158,10 @@ fn run(
                 if info < 0 {
                     break;
                 }
-                return Err(ArpackError::UnexpectedRequest { ido: other });
+                return Err(ArpackError::UnexpectedRequest {
+                    routine: Routine::Dsaupd,
+                    ido: other,
+                });
             }
         }
     }

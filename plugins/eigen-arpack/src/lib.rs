@@ -2,7 +2,9 @@
 //!
 //! The `arpack` eigen solver: ARPACK's implicitly restarted Lanczos method
 //! (`dsaupd`/`dseupd`, ARPACK-NG through [`arpack_ffi`]) in shift-invert mode on the
-//! symmetric generalized problem of the normal modes,
+//! symmetric generalized problem of the normal modes, and its implicitly restarted
+//! Arnoldi method (`znaupd`/`zneupd`) for the complex modes of the frictional quadratic
+//! eigenproblem (see the last section). Normal modes:
 //!
 //! ```text
 //! K x = lambda M x,   lambda = omega^2,   K = K^T >= 0,   M = M^T > 0.
@@ -36,24 +38,44 @@
 //! ARPACK is not thread safe (Fortran `SAVE` state): runs are serialized by
 //! [`arpack_ffi::ARPACK_LOCK`]. The start vector is fixed, so results are reproducible.
 //!
+//! ## Complex modes of the frictional QEP
+//!
+//! [`EigenSolver::solve_qep`] runs the band driver of squeal-core
+//! ([`squeal_core::qep::solve_qep_band`]) with [`ArpackComplexKernel`]: ARPACK's complex
+//! Arnoldi iteration `znaupd`/`zneupd` in *standard mode 1* (`bmat = 'I'`,
+//! `which = "LM"`) on the user operator `OP = (A - sigma B)^-1 B` of the companion form
+//! at a complex shift `sigma = i 2 pi f_c`
+//! ([`QepShiftInvert`](squeal_core::qep::QepShiftInvert)). ARPACK's generalized modes
+//! need a Hermitian positive semi-definite `B`, which `B = [I 0; 0 M~]` with a
+//! non-symmetric `M~` is not, hence the standard mode on the shift-inverted operator.
+//! The only reverse-communication request is `ido = -1 / 1`: `y = OP x`. The kernel
+//! returns the operator eigenvalues `theta`; the driver maps them back,
+//! `lambda = sigma + 1 / theta`.
+//!
 //! Reference: R. B. Lehoucq, D. C. Sorensen, C. Yang, *ARPACK Users' Guide: Solution of
 //! Large-Scale Eigenvalue Problems with Implicitly Restarted Arnoldi Methods*, SIAM,
 //! Philadelphia, 1998 (section 3.2.3 and appendix for `dsaupd` mode 3; `info` codes
-//! from the `dsaupd`/`dseupd` prologues).
+//! from the `dsaupd`/`dseupd` and `znaupd`/`zneupd` prologues).
 
+mod complex;
 mod error;
 mod kernel;
 
+pub use complex::ArpackComplexKernel;
 pub use error::{ArpackError, Routine};
 pub use kernel::ArpackKernel;
 
 use squeal_core::eigen::SymmetricKernel;
-use squeal_core::{EigenParams, EigenSolver, Params, RealModes, Result, SymmetricProblem};
+use squeal_core::qep::ComplexKernel;
+use squeal_core::{
+    ComplexModes, EigenParams, EigenSolver, Params, Qep, RealModes, Result, SymmetricProblem,
+};
 
 /// The registered name.
 pub const NAME: &str = "arpack";
 
-/// The `arpack` [`EigenSolver`]: the shared band driver around [`ArpackKernel`].
+/// The `arpack` [`EigenSolver`]: the shared band drivers around [`ArpackKernel`]
+/// (normal modes) and [`ArpackComplexKernel`] (complex modes of the QEP).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ArpackSolver;
 
@@ -67,6 +89,11 @@ impl ArpackSolver {
     /// The Krylov kernel used by [`EigenSolver::solve_symmetric`].
     pub fn kernel(&self) -> &dyn SymmetricKernel {
         &ArpackKernel
+    }
+
+    /// The Krylov kernel used by [`EigenSolver::solve_qep`].
+    pub fn complex_kernel(&self) -> &dyn ComplexKernel {
+        &ArpackComplexKernel
     }
 }
 
@@ -82,16 +109,23 @@ impl EigenSolver for ArpackSolver {
     ) -> Result<RealModes> {
         squeal_core::solve_symmetric_band(NAME, &ArpackKernel, problem, params)
     }
+
+    fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {
+        squeal_core::qep::solve_qep_band(NAME, &ArpackComplexKernel, qep, params)
+    }
 }
 
 /// Registers the `arpack` eigen solver.
 pub fn register(reg: &mut squeal_core::Registry) {
     reg.eigen.register(
         NAME,
-        "ARPACK shift-invert Lanczos (dsaupd mode 3) on a sparse Cholesky of K - sigma M",
+        "ARPACK shift-invert Lanczos (dsaupd mode 3) on a sparse Cholesky of K - sigma M; \
+         complex modes by znaupd (mode 1) on the companion shift-invert operator (sparse LU)",
         |p| Ok(Box::new(ArpackSolver::new(p)?)),
     );
 }
 
+#[cfg(test)]
+mod complex_tests;
 #[cfg(test)]
 mod tests;
