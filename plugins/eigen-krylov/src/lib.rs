@@ -4,6 +4,11 @@
 //! for symmetric operators is the same method as Stewart's Krylov-Schur (2001), run on
 //! the shift-invert operator of the normal-mode problem. Registered as `"krylov"`.
 //!
+//! The frictional (non-symmetric, quadratic) problem goes through the complex kernel
+//! [`KrylovSchurKernel`] (module [`schur`]: Krylov-Schur in complex arithmetic with
+//! locking and validation runs for repeated eigenvalues), run by the shared band driver
+//! [`squeal_core::qep::solve_qep_band`] on the companion-form shift-invert operator.
+//!
 //! ## Spectral transformation
 //!
 //! Normal modes solve `K x = lambda M x` (`lambda = omega^2`). With a shift `sigma`
@@ -112,18 +117,23 @@ use squeal_core::faer::linalg::matmul::matmul;
 use squeal_core::faer::{self, Accum, Mat, MatMut, MatRef, Par, Side};
 use squeal_core::linalg::{dot, ShiftInvert};
 use squeal_core::{
-    EigenParams, EigenSolver, Error, Params, RealModes, Registry, Result, SymmetricProblem,
+    ComplexModes, EigenParams, EigenSolver, Error, Params, Qep, RealModes, Registry, Result,
+    SymmetricProblem,
 };
 
+pub mod schur;
 #[cfg(test)]
 mod tests;
+
+pub use schur::KrylovSchurKernel;
 
 /// Name under which the solver is registered.
 pub const NAME: &str = "krylov";
 
 /// One-line description shown by the registry.
 pub const DESCRIPTION: &str = "pure-Rust thick-restart Lanczos (M inner product, full \
-                               reorthogonalization) on a sparse Cholesky of K - sigma M";
+                               reorthogonalization) on a sparse Cholesky of K - sigma M; \
+                               complex Krylov-Schur for the frictional QEP";
 
 /// A residual below this fraction of `||OP v_j||_M` is a breakdown (invariant subspace).
 const BREAKDOWN: f64 = 1e-12;
@@ -163,6 +173,12 @@ impl EigenSolver for KrylovSolver {
         params: &EigenParams,
     ) -> Result<RealModes> {
         squeal_core::solve_symmetric_band(NAME, &LanczosKernel, problem, params)
+    }
+
+    /// The frictional QEP: the shared complex band driver
+    /// [`squeal_core::qep::solve_qep_band`] around [`KrylovSchurKernel`].
+    fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {
+        squeal_core::qep::solve_qep_band(NAME, &KrylovSchurKernel, qep, params)
     }
 }
 
