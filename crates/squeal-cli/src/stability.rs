@@ -75,7 +75,7 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
             anyhow::bail!("give either a scene or --operator DIR, not both");
         }
         let start = Instant::now();
-        let op = read_operator_dir(dir)?;
+        let op = squeal_io::read_operator_dir(dir)?;
         let mu = a.mu.context("--mu is required with --operator")?;
         squeal_contact::check_user_mu(mu)?;
         return Ok(Source {
@@ -187,9 +187,3 @@ pub fn print(r: &StabilityReport) {
     }
 }
 
-fn read_operator_dir(dir: &Path) -> Result<FrictionalOperator> {
-    anyhow::bail!(
-        "{}: reading operator directories is not available in this build",
-        dir.display()
-    )
-}
