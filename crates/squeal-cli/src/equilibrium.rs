@@ -184,7 +184,11 @@ pub fn run(
     };
     let path = out.join("equilibrium.json");
     std::fs::write(&path, json).with_context(|| format!("writing {}", path.display()))?;
-    let grid = setup.model.contact.as_ref().expect("a contact set has a grid");
+    let grid = setup
+        .model
+        .contact
+        .as_ref()
+        .expect("a contact set has a grid");
     let cell = [grid.xs[1] - grid.xs[0], grid.ys[1] - grid.ys[0]];
     let panels: Vec<squeal_plot::MapPanel> = eqs
         .iter()
@@ -206,7 +210,11 @@ pub fn run(
         &out.join("contact_map"),
         &format!(
             "Normal contact force per pair, {} N total ({solver}, {law})",
-            setup.scene.load.normal_force_n.map_or("imposed-displacement".to_string(), |f| format!("{f}"))
+            setup
+                .scene
+                .load
+                .normal_force_n
+                .map_or("imposed-displacement".to_string(), |f| format!("{f}"))
         ),
         "Rn (N)",
         &panels,

@@ -117,6 +117,24 @@ enum Command {
         #[arg(long)]
         json: Option<std::path::PathBuf>,
     },
+    /// Writes the frictional operator of a scene at its equilibrium for MU, in both forms:
+    /// constrained parts (Mc, Kc, FM, FK, T) and full form (M, K, pairs.csv), + README.txt.
+    Export {
+        /// Scene file (TOML) or embedded scene name; default: `pin-on-disc`.
+        scene: Option<String>,
+        /// Friction coefficient of the equilibrium (default: the scene's study.mu).
+        #[arg(long)]
+        mu: Option<f64>,
+        /// Equilibrium solver plugin.
+        #[arg(long, default_value = "lcp")]
+        equilibrium: String,
+        /// Contact law plugin.
+        #[arg(long, default_value = "lagrange")]
+        law: String,
+        /// Output directory.
+        #[arg(long)]
+        out: std::path::PathBuf,
+    },
     /// Lists the registered plugins.
     Plugins,
     /// Scene inspection.
@@ -350,6 +368,13 @@ fn run() -> Result<()> {
                     .with_context(|| format!("writing {}", path.display()))?;
             }
         }
+        Command::Export {
+            scene,
+            mu,
+            equilibrium,
+            law,
+            out,
+        } => stability::export(&registry, scene.as_deref(), mu, &equilibrium, &law, &out)?,
         Command::Plugins => {
             for (kind, list) in [
                 ("material", registry.materials.describe()),

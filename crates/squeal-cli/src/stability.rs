@@ -75,7 +75,7 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
             anyhow::bail!("give either a scene or --operator DIR, not both");
         }
         let start = Instant::now();
-        let op = squeal_io::read_operator_dir(dir)?;
+        let op = read_operator_any(dir)?;
         let mu = a.mu.context("--mu is required with --operator")?;
         squeal_contact::check_user_mu(mu)?;
         return Ok(Source {
@@ -187,3 +187,82 @@ pub fn print(r: &StabilityReport) {
     }
 }
 
+/// Reads an operator directory in either form: the constrained parts (`Mc.mtx`, ...),
+/// preferred when present, or the full form (`M.mtx`, `K.mtx`, `pairs.csv`).
+pub fn read_operator_any(dir: &Path) -> Result<FrictionalOperator> {
+    if dir.join(squeal_io::FILE_MC).is_file() {
+        Ok(squeal_io::read_operator_dir(dir)?)
+    } else if squeal_contact::files::is_full_form(dir) {
+        Ok(squeal_contact::files::read_full_form(dir)?)
+    } else {
+        anyhow::bail!(
+            "{}: not an operator directory: expected Mc.mtx and Kc.mtx (constrained form) or \
+             M.mtx, K.mtx and pairs.csv (full form), as written by `squeal export`",
+            dir.display()
+        )
+    }
+}
+
+/// `squeal export`: both forms of a scene's operator at its equilibrium for `mu`.
+pub fn export(
+    registry: &Registry,
+    scene: Option<&str>,
+    mu: Option<f64>,
+    equilibrium: &str,
+    law: &str,
+    out: &Path,
+) -> Result<()> {
+    let (scene, file) = crate::load_scene(scene)?;
+    let mu = mu.unwrap_or(scene.study.mu);
+    let prep = Prepared::new(registry, scene, &file)?;
+    let eq = prep.equilibrium(registry, equilibrium, law, mu)?;
+    let op = prep.operator(&eq.eq.active)?;
+    let active = eq.eq.active.iter().filter(|&&a| a).count();
+    squeal_io::write_operator_dir(
+        out,
+        &op,
+        &squeal_io::OperatorMeta {
+            scene: prep.scene.name.clone(),
+            mu,
+            active_pairs: active,
+            source: format!(
+                "squeal {} export of {file}: equilibrium `{equilibrium}` with `{law}` at mu = {mu}",
+                env!("CARGO_PKG_VERSION")
+            ),
+        },
+    )?;
+    squeal_contact::files::write_full_form(
+        out,
+        &prep.model.m,
+        None,
+        &prep.model.k,
+        &prep.set,
+        &eq.eq.active,
+    )?;
+    let readme = out.join("README.txt");
+    let mut text = std::fs::read_to_string(&readme).unwrap_or_default();
+    text.push_str(&format!(
+        "\nFULL FORM (the same operator before elimination)\n\
+         M.mtx, K.mtx: mass (kg) and stiffness (N/m) on the {} free DOFs of the model\n\
+         (Dirichlet DOFs eliminated; no damping in this scene, so no C.mtx).\n\
+         pairs.csv: one row per candidate contact pair ({} pairs, {active} active at mu = {mu}):\n\
+         pin_dof_x..z, disc_dof_x..z (0-based rows of M and K), x_m, y_m (position), nx, ny, nz\n\
+         (normal, +z from the disc into the pin), ex, ey, ez (unit sliding direction: the disc's\n\
+         surface velocity), active (1 = in the effective contact set).\n\
+         The constrained form eliminates each active pair's pin-normal DOF onto its disc\n\
+         partner (T.txt: constrained index of every full DOF) and keeps the friction parts\n\
+         apart. `squeal stability --operator DIR` reads the constrained form when present and\n\
+         builds it from the full form otherwise.\n",
+        prep.model.dofs.n_free(),
+        prep.set.len()
+    ));
+    std::fs::write(&readme, text)?;
+    println!(
+        "wrote {}: constrained operator ({} DOFs) and full form ({} DOFs, {} pairs, {active} active) at mu = {mu}",
+        out.display(),
+        op.dim(),
+        prep.model.dofs.n_free(),
+        prep.set.len()
+    );
+    Ok(())
+}

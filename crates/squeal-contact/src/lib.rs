@@ -18,6 +18,7 @@
 //!
 //! Units: SI (m, N, kg, s).
 
+pub mod files;
 pub mod operator;
 
 pub use operator::build_operator;
@@ -66,6 +67,8 @@ pub struct ContactSet {
     pub pt: SparseMat,
     /// Rotation sense (+1 counter-clockwise about +z).
     pub rotation: f64,
+    /// Number of free DOFs of the model (columns of `Pn`, `Pt`).
+    pub n: usize,
 }
 
 impl ContactSet {
@@ -175,9 +178,27 @@ impl ContactSet {
                 [-rotation * y / r, rotation * x / r, 0.0]
             })
             .collect();
+        let mut set = ContactSet {
+            grid_index: (0..nc).collect(),
+            xy,
+            pin_dofs,
+            disc_dofs,
+            direction,
+            pn: SparseMat::try_new_from_triplets(nc, n, &[]).expect("empty"),
+            pt: SparseMat::try_new_from_triplets(nc, n, &[]).expect("empty"),
+            rotation,
+            n,
+        };
+        set.rebuild_projections()?;
+        Ok(set)
+    }
+
+    /// Rebuilds `Pn` and `Pt` from the pairs' DOFs and directions.
+    pub fn rebuild_projections(&mut self) -> Result<()> {
+        let (nc, n) = (self.len(), self.n);
         let (mut tn, mut tt) = (Vec::new(), Vec::new());
         for i in 0..nc {
-            let (s, m, e) = (pin_dofs[i], disc_dofs[i], direction[i]);
+            let (s, m, e) = (self.pin_dofs[i], self.disc_dofs[i], self.direction[i]);
             tn.push(Triplet::new(i, s[2], 1.0));
             tn.push(Triplet::new(i, m[2], -1.0));
             for a in 0..3 {
@@ -187,26 +208,18 @@ impl ContactSet {
                 }
             }
         }
-        let pn = SparseMat::try_new_from_triplets(nc, n, &tn).map_err(|e| ContactError::Setup {
-            field: "pairs".into(),
-            message: format!("building Pn: {e:?}"),
-        })?;
-        let pt = SparseMat::try_new_from_triplets(nc, n, &tt).map_err(|e| ContactError::Setup {
-            field: "pairs".into(),
-            message: format!("building Pt: {e:?}"),
-        })?;
-        Ok(ContactSet {
-            grid_index: (0..nc).collect(),
-            xy,
-            pin_dofs,
-            disc_dofs,
-            direction,
-            pn,
-            pt,
-            rotation,
-        })
+        self.pn =
+            SparseMat::try_new_from_triplets(nc, n, &tn).map_err(|e| ContactError::Setup {
+                field: "pairs".into(),
+                message: format!("building Pn: {e:?}"),
+            })?;
+        self.pt =
+            SparseMat::try_new_from_triplets(nc, n, &tt).map_err(|e| ContactError::Setup {
+                field: "pairs".into(),
+                message: format!("building Pt: {e:?}"),
+            })?;
+        Ok(())
     }
-
     /// Number of candidate pairs.
     pub fn len(&self) -> usize {
         self.grid_index.len()
