@@ -87,6 +87,27 @@ impl ContactSet {
             });
         }
         let (x_lo, y_lo) = (grid.xs[0], grid.ys[0]);
+        let size = [
+            grid.xs[grid.xs.len() - 1] - x_lo,
+            grid.ys[grid.ys.len() - 1] - y_lo,
+        ];
+        let in_rect = |p: usize, r: &[f64; 4]| -> bool {
+            let (x, y) = (grid.xy[p][0] - x_lo, grid.xy[p][1] - y_lo);
+            let eps = 1e-9 * (size[0] + size[1]);
+            x >= r[0] - eps && x <= r[0] + r[2] + eps && y >= r[1] - eps && y <= r[1] + r[3] + eps
+        };
+        let plateaus = zone.plateau_rectangles(size);
+        if let Zone::Mask {
+            values: Some(v), ..
+        } = zone
+        {
+            if v.len() != grid.len() {
+                return Err(ContactError::Setup {
+                    field: "contact.zone.values".into(),
+                    message: format!("expected {} mask values, got {}", grid.len(), v.len()),
+                });
+            }
+        }
         let inside = |p: usize| -> bool {
             match zone {
                 Zone::Uniform => true,
@@ -95,14 +116,11 @@ impl ContactSet {
                     y0_m,
                     a_m,
                     b_m,
-                } => {
-                    let (x, y) = (grid.xy[p][0] - x_lo, grid.xy[p][1] - y_lo);
-                    let eps = 1e-9 * (a_m + b_m);
-                    x >= x0_m - eps
-                        && x <= x0_m + a_m + eps
-                        && y >= y0_m - eps
-                        && y <= y0_m + b_m + eps
-                }
+                } => in_rect(p, &[*x0_m, *y0_m, *a_m, *b_m]),
+                Zone::Plateaus { .. } => plateaus
+                    .as_ref()
+                    .is_some_and(|rs| rs.iter().any(|r| in_rect(p, r))),
+                Zone::Mask { values, .. } => values.as_ref().is_some_and(|v| v[p] == 1),
             }
         };
         let dof = |node: usize, what: &str| -> Result<[usize; 3]> {

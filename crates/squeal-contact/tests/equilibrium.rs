@@ -277,3 +277,40 @@ fn bad_input_gives_clear_errors() {
         .to_string();
     assert!(msg.contains("contact.zone"), "{msg}");
 }
+
+#[test]
+fn zones_select_their_pairs() {
+    let fx = fixture();
+    let rect = Zone::Rectangle {
+        x0_m: 0.010,
+        y0_m: 0.0,
+        a_m: 0.010,
+        b_m: 0.020,
+    };
+    // 11 of 21 columns, every row
+    assert_eq!(
+        ContactSet::new(&fx.model, &rect, 1.0).unwrap().len(),
+        11 * 21
+    );
+    let plateaus = Zone::Plateaus {
+        patch_m: 0.005,
+        seed: 42,
+        fraction: None,
+        count: Some(1),
+        region_m: None,
+    };
+    // one 5 mm patch on a 1 mm grid: 6 x 6 pairs
+    let set = ContactSet::new(&fx.model, &plateaus, 1.0).unwrap();
+    assert_eq!(set.len(), 36);
+    let mut values = vec![0u8; fx.set.len()];
+    values[0] = 1;
+    values[440] = 1;
+    let mask = Zone::Mask {
+        values: Some(values),
+        file: None,
+    };
+    let set = ContactSet::new(&fx.model, &mask, 1.0).unwrap();
+    assert_eq!(set.grid_index, vec![0, 440]);
+    // the corner pairs of the mask are the face's corners
+    assert!(set.xy[0][0] < set.xy[1][0] && set.xy[0][1] < set.xy[1][1]);
+}

@@ -203,6 +203,89 @@ pub enum Zone {
         /// Width along y (m).
         b_m: f64,
     },
+    /// Mesoscopic plateaus: the region (default the whole pin face; else the rectangle
+    /// `region_m = [x0, y0, a, b]` as for `rectangle`) is cut into square patches of side
+    /// `patch_m`, and a seeded random subset of them (`fraction` of the patches, or
+    /// `count` patches) may touch. The same seed gives the same layout on every machine
+    /// (splitmix64 + Fisher-Yates).
+    Plateaus {
+        /// Patch side (m).
+        patch_m: f64,
+        /// Random seed.
+        seed: u64,
+        /// Fraction of the patches in contact, in (0, 1].
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        fraction: Option<f64>,
+        /// Number of patches in contact.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        count: Option<usize>,
+        /// Region cut into patches, `[x0, y0, a, b]` (m); absent: the whole face.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        region_m: Option<[f64; 4]>,
+    },
+    /// An explicit mask: one 0/1 per pair, row by row (along x) from the pin face's
+    /// (-x, -y) corner, `(pin_face_elements + 1)^2` values; inline (`values`) or in a text
+    /// file (`file`, whitespace or comma separated, relative to the scene file).
+    Mask {
+        /// The mask values.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        values: Option<Vec<u8>>,
+        /// A mask file.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        file: Option<String>,
+    },
+}
+
+impl Zone {
+    /// The rectangles `[x0, y0, a, b]` (m, from the pin face's corner) of a plateau
+    /// layout on a face of `size = [size_x, size_y]`; `None` for other zones.
+    pub fn plateau_rectangles(&self, size: [f64; 2]) -> Option<Vec<[f64; 4]>> {
+        let Zone::Plateaus {
+            patch_m,
+            seed,
+            fraction,
+            count,
+            region_m,
+        } = self
+        else {
+            return None;
+        };
+        let [x0, y0, a, b] = region_m.unwrap_or([0.0, 0.0, size[0], size[1]]);
+        let nx = ((a / patch_m).round() as usize).max(1);
+        let ny = ((b / patch_m).round() as usize).max(1);
+        let (px, py) = (a / nx as f64, b / ny as f64);
+        let total = nx * ny;
+        let want = match (fraction, count) {
+            (Some(f), _) => ((f * total as f64).round() as usize).clamp(1, total),
+            (None, Some(c)) => (*c).clamp(1, total),
+            (None, None) => total,
+        };
+        let mut state = *seed;
+        let mut next = || {
+            // splitmix64
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        };
+        let mut idx: Vec<usize> = (0..total).collect();
+        for i in (1..total).rev() {
+            let j = (next() % (i as u64 + 1)) as usize;
+            idx.swap(i, j);
+        }
+        let mut chosen: Vec<usize> = idx[..want].to_vec();
+        chosen.sort_unstable();
+        Some(
+            chosen
+                .iter()
+                .map(|&k| {
+                    let (i, j) = (k % nx, k / nx);
+                    [x0 + i as f64 * px, y0 + j as f64 * py, px, py]
+                })
+                .collect(),
+        )
+    }
 }
 
 /// Contact between the pin face and the disc.
@@ -275,7 +358,48 @@ impl Scene {
             file: file.clone(),
             source,
         })?;
-        Self::from_toml(&text, &file)
+        let mut scene: Scene = toml::from_str(&text).map_err(|e| SceneError::Parse {
+            file: file.clone(),
+            message: e.to_string(),
+        })?;
+        if let Zone::Mask {
+            values: values @ None,
+            file: Some(mask),
+        } = &mut scene.contact.zone
+        {
+            let mpath = path
+                .parent()
+                .unwrap_or(std::path::Path::new("."))
+                .join(&*mask);
+            let mname = mpath.display().to_string();
+            let mtext = std::fs::read_to_string(&mpath).map_err(|source| SceneError::Io {
+                file: format!("{mname} (contact.zone.file of {file})"),
+                source,
+            })?;
+            let mut v = Vec::new();
+            for (l, line) in mtext.lines().enumerate() {
+                let line = line.split('#').next().unwrap_or("");
+                for tok in line
+                    .split(|c: char| c == ',' || c.is_whitespace())
+                    .filter(|t| !t.is_empty())
+                {
+                    match tok {
+                        "0" => v.push(0u8),
+                        "1" => v.push(1u8),
+                        other => {
+                            return Err(SceneError::Field {
+                                file: format!("{mname}:{}", l + 1),
+                                field: "contact.zone.file".into(),
+                                message: format!("expected 0 or 1, got `{other}`"),
+                            })
+                        }
+                    }
+                }
+            }
+            *values = Some(v);
+        }
+        scene.validate(&file)?;
+        Ok(scene)
     }
 
     /// An embedded scene by name (`pin-on-disc`, `pin-on-disc-paper`).
@@ -519,6 +643,95 @@ impl Scene {
                     ),
                 ));
             }
+        }
+        match (&self.contact.zone, &self.pin) {
+            (
+                Zone::Plateaus {
+                    patch_m,
+                    fraction,
+                    count,
+                    region_m,
+                    ..
+                },
+                Some(p),
+            ) => {
+                let [x0, y0, a, b] = region_m.unwrap_or([0.0, 0.0, p.size_x_m, p.size_y_m]);
+                let inside = x0 >= 0.0
+                    && y0 >= 0.0
+                    && a > 0.0
+                    && b > 0.0
+                    && x0 + a <= p.size_x_m * (1.0 + 1e-9)
+                    && y0 + b <= p.size_y_m * (1.0 + 1e-9);
+                if !inside {
+                    return Err(field(
+                        "contact.zone.region_m",
+                        format!(
+                            "expected [x0, y0, a, b] inside the pin face ({} x {} m), got {:?}",
+                            p.size_x_m,
+                            p.size_y_m,
+                            [x0, y0, a, b]
+                        ),
+                    ));
+                }
+                if !(patch_m.is_finite() && *patch_m > 0.0 && *patch_m <= a.min(b) * (1.0 + 1e-9)) {
+                    return Err(field(
+                        "contact.zone.patch_m",
+                        format!(
+                            "expected a patch side in (0, {}] m, got {patch_m}",
+                            a.min(b)
+                        ),
+                    ));
+                }
+                match (fraction, count) {
+                    (Some(f), None) if *f > 0.0 && *f <= 1.0 => {}
+                    (None, Some(c)) if *c >= 1 => {}
+                    _ => {
+                        return Err(field(
+                            "contact.zone.fraction",
+                            "give exactly one of fraction (in (0, 1]) and count (>= 1)".into(),
+                        ))
+                    }
+                }
+            }
+            (Zone::Mask { values, file }, Some(_)) => {
+                let want = (m.pin_face_elements + 1) * (m.pin_face_elements + 1);
+                match (values, file) {
+                    (Some(v), _) => {
+                        if v.len() != want {
+                            return Err(field(
+                                "contact.zone.values",
+                                format!(
+                                    "expected {want} mask values ({0} x {0} pairs, row by row \
+                                     from the (-x, -y) corner), got {1}",
+                                    m.pin_face_elements + 1,
+                                    v.len()
+                                ),
+                            ));
+                        }
+                        if let Some(bad) = v.iter().find(|&&x| x > 1) {
+                            return Err(field(
+                                "contact.zone.values",
+                                format!("expected 0 or 1, got {bad}"),
+                            ));
+                        }
+                    }
+                    (None, Some(_)) => {
+                        return Err(field(
+                            "contact.zone.file",
+                            "a mask file is read relative to the scene file: load the scene \
+                             with Scene::from_file"
+                                .into(),
+                        ))
+                    }
+                    (None, None) => {
+                        return Err(field(
+                            "contact.zone",
+                            "a mask needs `values` or `file`".into(),
+                        ))
+                    }
+                }
+            }
+            _ => {}
         }
         if self.disc.is_none() && self.pin.is_none() {
             return Err(field(

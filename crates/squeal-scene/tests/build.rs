@@ -231,3 +231,90 @@ fn contact_grid_is_compatible_and_the_disc_stays_round() {
         );
     }
 }
+
+#[test]
+fn masks_and_plateaus_are_checked_and_reproducible() {
+    let base = Scene::builtin("pin-on-disc").unwrap();
+    let n = (base.mesh.pin_face_elements + 1).pow(2);
+    // inline mask with the wrong count
+    let mut bad = base.clone();
+    bad.contact.zone = squeal_scene::Zone::Mask {
+        values: Some(vec![1; n - 1]),
+        file: None,
+    };
+    let e = Scene::from_toml(&bad.to_toml(), "mask.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("mask.toml") && e.contains("contact.zone.values") && e.contains(&n.to_string()),
+        "{e}"
+    );
+    // a mask file: read relative to the scene, wrong count and bad token named
+    let dir = std::env::temp_dir().join(format!("squeal-mask-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut with_file = base.clone();
+    with_file.contact.zone = squeal_scene::Zone::Mask {
+        values: None,
+        file: Some("m.txt".into()),
+    };
+    std::fs::write(dir.join("s.toml"), with_file.to_toml()).unwrap();
+    std::fs::write(dir.join("m.txt"), "1 0 1\n").unwrap();
+    let e = Scene::from_file(&dir.join("s.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("contact.zone.values") && e.contains("got 3"),
+        "{e}"
+    );
+    std::fs::write(dir.join("m.txt"), "1 0 2\n").unwrap();
+    let e = Scene::from_file(&dir.join("s.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("m.txt:1") && e.contains("`2`"), "{e}");
+    let good: String = (0..n)
+        .map(|i| if i % 2 == 0 { "1 " } else { "0 " })
+        .collect();
+    std::fs::write(dir.join("m.txt"), good).unwrap();
+    let s = Scene::from_file(&dir.join("s.toml")).unwrap();
+    match &s.contact.zone {
+        squeal_scene::Zone::Mask {
+            values: Some(v), ..
+        } => {
+            assert_eq!(v.iter().filter(|&&x| x == 1).count(), n.div_ceil(2))
+        }
+        z => panic!("{z:?}"),
+    }
+    let e = Scene::from_file(&dir.join("missing.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("missing.toml"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+    // plateaus: the same seed gives the same layout, another seed another one
+    let z = |seed: u64| squeal_scene::Zone::Plateaus {
+        patch_m: 0.002,
+        seed,
+        fraction: Some(0.3),
+        count: None,
+        region_m: None,
+    };
+    let size = [0.02, 0.02];
+    let a = z(7).plateau_rectangles(size).unwrap();
+    assert_eq!(a, z(7).plateau_rectangles(size).unwrap());
+    assert_ne!(a, z(8).plateau_rectangles(size).unwrap());
+    assert_eq!(a.len(), 30); // 30 % of 10 x 10 patches
+    for r in &a {
+        assert!(r[0] >= 0.0 && r[0] + r[2] <= 0.02 + 1e-12 && r[1] + r[3] <= 0.02 + 1e-12);
+    }
+    let mut bad = base.clone();
+    bad.contact.zone = squeal_scene::Zone::Plateaus {
+        patch_m: 0.05,
+        seed: 1,
+        fraction: Some(0.5),
+        count: None,
+        region_m: None,
+    };
+    let e = Scene::from_toml(&bad.to_toml(), "p.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("contact.zone.patch_m"), "{e}");
+}
