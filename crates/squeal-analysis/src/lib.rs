@@ -9,4 +9,5 @@ pub mod labels;
 pub mod modal;
 pub mod pipeline;
 pub mod reference;
+pub mod sweep;
 pub mod vtu;

@@ -1,0 +1,378 @@
+//! Friction-coefficient sweeps: mode tracking by MAC continuity and coupling detection.
+//!
+//! Every complex mode of a sweep point is summarized by its **signature**: its
+//! coefficients on the free-interface normal modes `phi_k` of the bodies (no contact,
+//! `M`-orthonormal), `c_k = phi_k^T M u` on the full DOFs. Two modes are compared by the
+//! Hermitian MAC of their signatures, `|c_a^H c_b|^2 / (|c_a|^2 |c_b|^2)`, which is the MAC
+//! of the modes projected on the free-interface basis: cheap to store (one short complex
+//! vector per mode, however many DOFs), independent of the contact set (whose constrained
+//! spaces differ from mu to mu), and it is also the paper's Figure 7 (MAC of each unstable
+//! mode against the free-interface modes).
+//!
+//! **Tracking.** Branches are continued from one mu to the next by a greedy assignment on
+//! the product of the signature MAC and a frequency-proximity factor; a mode that matches
+//! no branch above `min_mac` starts a new branch. Disc doublets (two modes with nearly the
+//! same frequency and signatures spanning the same pair of free-interface modes) are the
+//! hard case: the greedy assignment takes the best MAC first, so a rotated doublet stays on
+//! its two branches as long as the pair keeps its subspace.
+//!
+//! **Couplings.** A coupling is a maximal run of consecutive sweep points where a branch is
+//! unstable (`DvR > dvr_tol`); it reports the frequency at the largest DvR, the mu interval
+//! (first and last unstable mu), the largest DvR and the partner branch: the branch with the
+//! nearest frequency and the most negative DvR over the same interval (the mode it merged
+//! with, whose DvR mirrors it).
+
+use serde::{Deserialize, Serialize};
+use squeal_core::c64;
+
+/// One mode of a sweep point.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct SweepMode {
+    /// Frequency (Hz).
+    pub freq_hz: f64,
+    /// Real part of lambda (1/s).
+    pub re: f64,
+    /// Divergence rate `Re / Im`.
+    pub dvr: f64,
+    /// Backward error on the full operator.
+    pub backward_error: f64,
+    /// Coefficients on the free-interface modes: (re, im) pairs.
+    pub signature: Vec<[f64; 2]>,
+}
+
+/// One friction coefficient of a sweep.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct SweepPoint {
+    /// Friction coefficient.
+    pub mu: f64,
+    /// Active contact pairs.
+    pub active_pairs: usize,
+    /// Whether the operator (and the basis) was rebuilt at this point.
+    pub rebuilt: bool,
+    /// Basis size (0 for full order).
+    pub basis_size: usize,
+    /// Wall times (s): equilibrium, operator + basis, eigen solve.
+    pub times_s: [f64; 3],
+    /// Modes in the band, sorted by frequency.
+    pub modes: Vec<SweepMode>,
+}
+
+/// A tracked branch: which mode it is at each sweep point (`None` where it is not found).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Branch {
+    /// Branch number.
+    pub id: usize,
+    /// Mode index at each sweep point.
+    pub modes: Vec<Option<usize>>,
+}
+
+/// A detected mode coupling (flutter).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Coupling {
+    /// Frequency at the largest DvR (Hz).
+    pub freq_hz: f64,
+    /// First unstable mu.
+    pub mu_from: f64,
+    /// Last unstable mu of the run.
+    pub mu_to: f64,
+    /// Largest divergence rate.
+    pub max_dvr: f64,
+    /// The unstable branch and its partner branch (when found).
+    pub partners: Vec<usize>,
+}
+
+/// Tuning of [`track`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackOptions {
+    /// Minimum signature MAC to continue a branch.
+    pub min_mac: f64,
+    /// Relative frequency scale of the proximity factor `exp(-(df/f / scale)^2)`.
+    pub freq_scale: f64,
+}
+
+impl Default for TrackOptions {
+    fn default() -> Self {
+        Self {
+            min_mac: 0.5,
+            freq_scale: 0.05,
+        }
+    }
+}
+
+/// Hermitian MAC of two signatures.
+pub fn signature_mac(a: &[[f64; 2]], b: &[[f64; 2]]) -> f64 {
+    let (mut re, mut im, mut na, mut nb) = (0.0, 0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        // conj(x) * y
+        re += x[0] * y[0] + x[1] * y[1];
+        im += x[0] * y[1] - x[1] * y[0];
+        na += x[0] * x[0] + x[1] * x[1];
+        nb += y[0] * y[0] + y[1] * y[1];
+    }
+    if na == 0.0 || nb == 0.0 {
+        0.0
+    } else {
+        (re * re + im * im) / (na * nb)
+    }
+}
+
+/// Signature of a full-DOF complex mode `u` on real `M`-orthonormal modes `phi`
+/// (`phi` columns; `mphi = M phi` precomputed): `c_k = (M phi_k)^T u`.
+pub fn signature(mphi: faer::MatRef<'_, f64>, u: &[c64]) -> Vec<[f64; 2]> {
+    (0..mphi.ncols())
+        .map(|k| {
+            let (mut re, mut im) = (0.0, 0.0);
+            for (r, z) in u.iter().enumerate() {
+                let w = mphi[(r, k)];
+                re += w * z.re;
+                im += w * z.im;
+            }
+            [re, im]
+        })
+        .collect()
+}
+
+use squeal_core::faer;
+
+/// Tracks modes along the sweep (points in increasing mu).
+pub fn track(points: &[SweepPoint], opts: &TrackOptions) -> Vec<Branch> {
+    let np = points.len();
+    let mut branches: Vec<Branch> = Vec::new();
+    // last seen mode of each branch: (point, mode)
+    let mut last: Vec<(usize, usize)> = Vec::new();
+    for (p, pt) in points.iter().enumerate() {
+        let mut cand: Vec<(f64, usize, usize)> = Vec::new();
+        for (b, &(lp, lm)) in last.iter().enumerate() {
+            // only branches seen at the previous point (or two back) can continue
+            if p - lp > 2 {
+                continue;
+            }
+            let prev = &points[lp].modes[lm];
+            for (m, md) in pt.modes.iter().enumerate() {
+                let mac = signature_mac(&prev.signature, &md.signature);
+                if mac < opts.min_mac {
+                    continue;
+                }
+                let df = (md.freq_hz - prev.freq_hz).abs() / prev.freq_hz.max(1e-300);
+                let prox = (-(df / opts.freq_scale).powi(2)).exp();
+                cand.push((mac * prox, b, m));
+            }
+        }
+        cand.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let mut taken_b = vec![false; last.len()];
+        let mut taken_m = vec![false; pt.modes.len()];
+        for (_, b, m) in cand {
+            if taken_b[b] || taken_m[m] {
+                continue;
+            }
+            taken_b[b] = true;
+            taken_m[m] = true;
+            branches[b].modes[p] = Some(m);
+            last[b] = (p, m);
+        }
+        for m in (0..pt.modes.len()).filter(|&m| !taken_m[m]) {
+            let mut modes = vec![None; np];
+            modes[p] = Some(m);
+            branches.push(Branch {
+                id: branches.len(),
+                modes,
+            });
+            last.push((p, m));
+        }
+    }
+    branches
+}
+
+/// Detects couplings: runs of consecutive points where a branch has `DvR > dvr_tol`.
+pub fn couplings(points: &[SweepPoint], branches: &[Branch], dvr_tol: f64) -> Vec<Coupling> {
+    let mut out = Vec::new();
+    let dvr = |b: &Branch, p: usize| b.modes[p].map(|m| points[p].modes[m].dvr);
+    let freq = |b: &Branch, p: usize| b.modes[p].map(|m| points[p].modes[m].freq_hz);
+    for b in branches {
+        let mut p = 0;
+        while p < points.len() {
+            if !dvr(b, p).is_some_and(|d| d > dvr_tol) {
+                p += 1;
+                continue;
+            }
+            let start = p;
+            while p < points.len() && dvr(b, p).is_some_and(|d| d > dvr_tol) {
+                p += 1;
+            }
+            let end = p - 1;
+            let (pk, dmax) = (start..=end)
+                .map(|q| (q, dvr(b, q).unwrap()))
+                .max_by(|a, c| a.1.total_cmp(&c.1))
+                .unwrap();
+            let f = freq(b, pk).unwrap();
+            // partner: nearest frequency at the peak with the most negative DvR
+            let partner = branches
+                .iter()
+                .filter(|o| o.id != b.id)
+                .filter_map(|o| {
+                    let (fo, d) = (freq(o, pk)?, dvr(o, pk)?);
+                    let df = (fo - f).abs() / f;
+                    (df < 0.02 && d < -0.5 * dmax).then_some((df, o.id))
+                })
+                .min_by(|a, c| a.0.total_cmp(&c.0))
+                .map(|x| x.1);
+            let mut partners = vec![b.id];
+            partners.extend(partner);
+            out.push(Coupling {
+                freq_hz: f,
+                mu_from: points[start].mu,
+                mu_to: points[end].mu,
+                max_dvr: dmax,
+                partners,
+            });
+        }
+    }
+    out.sort_by(|a, b| a.mu_from.total_cmp(&b.mu_from).then(a.freq_hz.total_cmp(&b.freq_hz)));
+    out
+}
+
+/// Appends finished points to a JSON-lines checkpoint and reads them back, so an
+/// interrupted sweep resumes where it stopped and never loses a finished point.
+pub struct Checkpoint {
+    path: std::path::PathBuf,
+}
+
+impl Checkpoint {
+    /// A checkpoint at `path` (created on first write).
+    pub fn new(path: impl Into<std::path::PathBuf>) -> Self {
+        Self { path: path.into() }
+    }
+
+    /// Points already computed (a truncated last line, from a crash mid-write, is
+    /// ignored).
+    pub fn load(&self) -> std::io::Result<Vec<SweepPoint>> {
+        match std::fs::read_to_string(&self.path) {
+            Ok(text) => Ok(text
+                .lines()
+                .filter_map(|l| serde_json::from_str::<SweepPoint>(l).ok())
+                .collect()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Vec::new()),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// Appends one point (flushed before returning).
+    pub fn append(&self, point: &SweepPoint) -> std::io::Result<()> {
+        use std::io::Write;
+        let mut f = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&self.path)?;
+        let line = serde_json::to_string(point).map_err(std::io::Error::other)?;
+        writeln!(f, "{line}")?;
+        f.sync_data()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mode(f: f64, dvr: f64, sig: &[f64]) -> SweepMode {
+        SweepMode {
+            freq_hz: f,
+            re: dvr * 2.0 * std::f64::consts::PI * f,
+            dvr,
+            backward_error: 0.0,
+            signature: sig.iter().map(|&x| [x, 0.0]).collect(),
+        }
+    }
+
+    fn point(mu: f64, modes: Vec<SweepMode>) -> SweepPoint {
+        SweepPoint {
+            mu,
+            active_pairs: 1,
+            rebuilt: false,
+            basis_size: 0,
+            times_s: [0.0; 3],
+            modes,
+        }
+    }
+
+    /// Two modes approach, merge (flutter: equal frequency, DvR +-) and separate again;
+    /// a third one crosses them in frequency with its own signature.
+    fn synthetic() -> Vec<SweepPoint> {
+        let mut pts = Vec::new();
+        for k in 0..11 {
+            let mu = 0.1 * k as f64;
+            let (fa, fb) = (2000.0 + 40.0 * mu, 2100.0 - 40.0 * mu);
+            let mut modes = Vec::new();
+            if (0.4..0.75).contains(&mu) {
+                let fm = 0.5 * (fa + fb);
+                let d = 0.01 * (1.0 - ((mu - 0.55) / 0.2).powi(2));
+                modes.push(mode(fm, d, &[0.7, 0.7, 0.0]));
+                modes.push(mode(fm, -d, &[0.7, -0.7, 0.0]));
+            } else {
+                modes.push(mode(fa, 0.0, &[1.0, 0.1 * mu, 0.0]));
+                modes.push(mode(fb, 0.0, &[0.1 * mu, 1.0, 0.0]));
+            }
+            modes.push(mode(1800.0 + 500.0 * mu, 0.0, &[0.0, 0.0, 1.0]));
+            modes.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
+            pts.push(point(mu, modes));
+        }
+        pts
+    }
+
+    #[test]
+    fn tracking_follows_signatures_through_a_crossing() {
+        let pts = synthetic();
+        let br = track(&pts, &TrackOptions::default());
+        // the crossing mode keeps one branch from start to end
+        let crossing = br
+            .iter()
+            .find(|b| {
+                b.modes
+                    .iter()
+                    .enumerate()
+                    .all(|(p, m)| m.is_some_and(|m| pts[p].modes[m].signature[2][0] == 1.0))
+            })
+            .expect("the crossing mode is one branch");
+        assert!(crossing.modes.iter().all(Option::is_some));
+    }
+
+    #[test]
+    fn coupling_is_detected_with_interval_peak_and_partner() {
+        let pts = synthetic();
+        let br = track(&pts, &TrackOptions::default());
+        let c = couplings(&pts, &br, 1e-6);
+        assert_eq!(c.len(), 1, "{c:?}");
+        let c = &c[0];
+        approx::assert_abs_diff_eq!(c.mu_from, 0.4, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(c.mu_to, 0.7, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(c.freq_hz, 2050.0, epsilon = 1e-9);
+        assert!(c.max_dvr > 0.009);
+        assert_eq!(c.partners.len(), 2, "the stable mirror is the partner");
+    }
+
+    #[test]
+    fn checkpoint_round_trip_ignores_a_torn_line() {
+        let path = std::env::temp_dir().join(format!("squeal-ckpt-{}.jsonl", std::process::id()));
+        std::fs::remove_file(&path).ok();
+        let ck = Checkpoint::new(&path);
+        assert!(ck.load().unwrap().is_empty());
+        let pts = synthetic();
+        ck.append(&pts[0]).unwrap();
+        ck.append(&pts[1]).unwrap();
+        // a crash mid-write leaves half a line
+        use std::io::Write;
+        let mut f = std::fs::OpenOptions::new().append(true).open(&path).unwrap();
+        write!(f, "{{\"mu\": 0.2, \"act").unwrap();
+        let back = ck.load().unwrap();
+        assert_eq!(back, pts[..2].to_vec());
+        std::fs::remove_file(&path).ok();
+    }
+
+    #[test]
+    fn mac_is_hermitian_and_phase_free() {
+        let a = [[1.0, 0.0], [0.0, 1.0]];
+        let b = [[0.0, 2.0], [-2.0, 0.0]]; // 2i * a
+        approx::assert_relative_eq!(signature_mac(&a, &b), 1.0, max_relative = 1e-15);
+        let c = [[1.0, 0.0], [0.0, -1.0]];
+        assert!(signature_mac(&a, &c) < 1e-15);
+    }
+}
