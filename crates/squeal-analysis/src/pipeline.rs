@@ -144,3 +144,157 @@ pub fn solve_modes(
         )))?;
     Ok((modes, solver))
 }
+
+/// Free-interface normal modes of the scene's bodies (no contact), the reference of mode
+/// signatures, tracking and the MAC chart.
+pub struct FreeModes {
+    /// Frequencies (Hz).
+    pub freq_hz: Vec<f64>,
+    /// `body:label` of each mode (e.g. `disc:a,0,3`, `pin:tilt-y`).
+    pub labels: Vec<String>,
+    /// `M phi` on the model's free DOFs, one column per mode (`phi` M-orthonormal).
+    pub mphi: squeal_core::faer::Mat<f64>,
+}
+
+impl Prepared {
+    /// Normal modes of the bodies without contact up to `fmax_hz`.
+    pub fn free_interface_modes(
+        &self,
+        registry: &Registry,
+        eigen: &str,
+        fmax_hz: f64,
+    ) -> Result<FreeModes> {
+        let solver = registry
+            .eigen
+            .create(eigen, &Params::new())
+            .map_err(core("eigen solver"))?;
+        let params = EigenParams {
+            fmax_hz,
+            ..EigenParams::default()
+        };
+        let (modes, records) = crate::modal::normal_modes(&self.model, solver.as_ref(), &params)
+            .map_err(core("free-interface modes"))?;
+        let n = self.model.m.nrows();
+        let k = modes.freq_hz.len();
+        let mut mphi = squeal_core::faer::Mat::<f64>::zeros(n, k);
+        let mut y = vec![0.0; n];
+        for c in 0..k {
+            let x: Vec<f64> = modes.vectors.col(c).iter().copied().collect();
+            squeal_core::linalg::spmv(self.model.m.as_ref(), &x, &mut y);
+            for r in 0..n {
+                mphi[(r, c)] = y[r];
+            }
+        }
+        Ok(FreeModes {
+            freq_hz: modes.freq_hz.clone(),
+            labels: records
+                .iter()
+                .map(|r| format!("{}:{}", r.body, r.label))
+                .collect(),
+            mphi,
+        })
+    }
+}
+
+/// Converts the complex modes of `op` into a sweep point (signatures on `free`).
+pub fn sweep_point(
+    op: &FrictionalOperator,
+    modes: &ComplexModes,
+    free: &FreeModes,
+    mu: f64,
+    active_pairs: usize,
+) -> crate::sweep::SweepPoint {
+    let out = (0..modes.len())
+        .map(|i| {
+            let uc: Vec<squeal_core::c64> = modes.vectors.col(i).iter().copied().collect();
+            let u = op.expand(&uc);
+            crate::sweep::SweepMode {
+                freq_hz: modes.freq_hz[i],
+                re: modes.lambda[i].re,
+                dvr: modes.dvr[i],
+                backward_error: modes.backward_error[i],
+                signature: crate::sweep::signature(free.mphi.as_ref(), &u),
+            }
+        })
+        .collect();
+    crate::sweep::SweepPoint {
+        mu,
+        active_pairs,
+        rebuilt: false,
+        basis_size: 0,
+        times_s: [0.0; 3],
+        modes: out,
+    }
+}
+
+/// What the solve step of a sweep returns: the modes, the basis size (0 for full order)
+/// and the time spent building the operator and basis (s).
+pub type StepResult = (ComplexModes, usize, f64);
+
+/// Runs a mu sweep: equilibrium per mu (the contact set may change), the operator rebuilt
+/// only when the active set changes, `solve(op, mu, rebuilt)` for the modes (full order
+/// or through a basis the closure keeps across calls), signatures on `free`. Points
+/// already in `checkpoint` are not recomputed; each new one is appended before the next
+/// starts. `progress` sees every point.
+#[allow(clippy::too_many_arguments)]
+pub fn run_mu_sweep(
+    prep: &Prepared,
+    registry: &Registry,
+    mus: &[f64],
+    equilibrium: &str,
+    law: &str,
+    free: &FreeModes,
+    checkpoint: Option<&crate::sweep::Checkpoint>,
+    mut solve: impl FnMut(&FrictionalOperator, f64, bool) -> Result<StepResult>,
+    mut progress: impl FnMut(&crate::sweep::SweepPoint),
+) -> Result<Vec<crate::sweep::SweepPoint>> {
+    let done = match checkpoint {
+        Some(c) => c.load().map_err(|e| PipelineError::Core {
+            stage: "reading the sweep checkpoint".into(),
+            source: squeal_core::Error::Invalid(e.to_string()),
+        })?,
+        None => Vec::new(),
+    };
+    let mut points = Vec::new();
+    let mut current: Option<(Vec<bool>, FrictionalOperator)> = None;
+    for &mu in mus {
+        if let Some(p) = done
+            .iter()
+            .find(|p| (p.mu - mu).abs() <= 1e-12 * (1.0 + mu.abs()))
+        {
+            progress(p);
+            points.push(p.clone());
+            continue;
+        }
+        let t0 = Instant::now();
+        let eq = prep.equilibrium(registry, equilibrium, law, mu)?;
+        let t_eq = t0.elapsed().as_secs_f64();
+        let t1 = Instant::now();
+        let rebuilt = !matches!(&current, Some((a, _)) if *a == eq.eq.active);
+        if rebuilt {
+            current = Some((eq.eq.active.clone(), prep.operator(&eq.eq.active)?));
+        }
+        let t_op = t1.elapsed().as_secs_f64();
+        let op = &current.as_ref().expect("operator built").1;
+        let (modes, basis_size, basis_time) = solve(op, mu, rebuilt)?;
+        let mut pt = sweep_point(
+            op,
+            &modes,
+            free,
+            mu,
+            eq.eq.active.iter().filter(|&&a| a).count(),
+        );
+        pt.rebuilt = rebuilt;
+        pt.basis_size = basis_size;
+        pt.times_s = [t_eq, t_op + basis_time, modes.info.time_s];
+        if let Some(c) = checkpoint {
+            c.append(&pt).map_err(|e| PipelineError::Core {
+                stage: "writing the sweep checkpoint".into(),
+                source: squeal_core::Error::Invalid(e.to_string()),
+            })?;
+        }
+        progress(&pt);
+        points.push(pt);
+    }
+    Ok(points)
+}

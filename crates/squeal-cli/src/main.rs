@@ -4,6 +4,7 @@ mod equilibrium;
 mod modes;
 mod scene_cmd;
 mod stability;
+mod sweep;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -135,12 +136,58 @@ enum Command {
         #[arg(long)]
         out: std::path::PathBuf,
     },
+    /// Parameter sweeps.
+    Sweep {
+        #[command(subcommand)]
+        kind: SweepKind,
+    },
     /// Lists the registered plugins.
     Plugins,
     /// Scene inspection.
     Scene {
         #[command(subcommand)]
         action: SceneAction,
+    },
+}
+
+#[derive(Subcommand)]
+enum SweepKind {
+    /// Friction-coefficient sweep: equilibrium, operator (rebuilt when the contact set
+    /// changes), modes, tracking by MAC, couplings; sweep.csv, summary.json and charts.
+    /// Resumes from DIR/sweep.partial.jsonl.
+    Mu {
+        /// Scene file (TOML) or embedded scene name; default: `pin-on-disc`.
+        scene: Option<String>,
+        #[arg(long, default_value_t = 0.0)]
+        from: f64,
+        #[arg(long, default_value_t = 0.8)]
+        to: f64,
+        #[arg(long, default_value_t = 0.01)]
+        step: f64,
+        /// Reduction basis plugin, or `none` for full order.
+        #[arg(long, default_value = "none")]
+        basis: String,
+        /// Basis parameters `key=value`.
+        #[arg(long = "basis-opt")]
+        basis_opt: Vec<String>,
+        /// Eigen solver plugin (of the reduced problem when a basis is given).
+        #[arg(long, default_value = "arpack")]
+        eigen: String,
+        /// Frequency band `FMIN:FMAX` (Hz).
+        #[arg(long, default_value = "0:10000")]
+        band: String,
+        /// Equilibrium solver plugin.
+        #[arg(long, default_value = "lcp")]
+        equilibrium: String,
+        /// Contact law plugin.
+        #[arg(long, default_value = "lagrange")]
+        law: String,
+        /// A mode is unstable when its DvR exceeds this.
+        #[arg(long, default_value_t = 1e-6)]
+        dvr_tol: f64,
+        /// Output directory.
+        #[arg(long, default_value = "out/sweep-mu")]
+        out: std::path::PathBuf,
     },
 }
 
@@ -375,6 +422,57 @@ fn run() -> Result<()> {
             law,
             out,
         } => stability::export(&registry, scene.as_deref(), mu, &equilibrium, &law, &out)?,
+        Command::Sweep {
+            kind:
+                SweepKind::Mu {
+                    scene,
+                    from,
+                    to,
+                    step,
+                    basis,
+                    basis_opt,
+                    eigen,
+                    band,
+                    equilibrium,
+                    law,
+                    dvr_tol,
+                    out,
+                },
+        } => {
+            let args = sweep::Args {
+                scene: scene.as_deref(),
+                from,
+                to,
+                step,
+                eigen: &eigen,
+                basis: &basis,
+                basis_opts: &basis_opt,
+                band: parse_band(&band)?,
+                equilibrium: &equilibrium,
+                law: &law,
+                dvr_tol,
+                out: &out,
+            };
+            let s = sweep::run(&registry, &args)?;
+            println!(
+                "{} points ({} contact sets), {} couplings, max backward error {:.1e}, {:.1} s",
+                s.points,
+                s.rebuilds,
+                s.couplings.len(),
+                s.max_backward_error,
+                s.time_s
+            );
+            for c in &s.couplings {
+                println!(
+                    "  {:>8.1} Hz  mu {:.3}-{:.3}  max DvR {:.4}  partners {:?}",
+                    c.freq_hz, c.mu_from, c.mu_to, c.max_dvr, c.partners
+                );
+            }
+            println!(
+                "wrote {}/{{sweep.csv,summary.json,*.svg,*.png}}",
+                out.display()
+            );
+        }
         Command::Plugins => {
             for (kind, list) in [
                 ("material", registry.materials.describe()),
