@@ -21,5 +21,8 @@ pub fn registry() -> Registry {
     squeal_eigen_arpack::register(&mut reg);
     squeal_eigen_krylov::register(&mut reg);
     squeal_eigen_dense::register(&mut reg);
+    squeal_basis_modes::register(&mut reg);
+    squeal_basis_enriched::register(&mut reg);
+    squeal_basis_residue::register(&mut reg);
     reg
 }

@@ -227,7 +227,11 @@ pub fn couplings(points: &[SweepPoint], branches: &[Branch], dvr_tol: f64) -> Ve
             });
         }
     }
-    out.sort_by(|a, b| a.mu_from.total_cmp(&b.mu_from).then(a.freq_hz.total_cmp(&b.freq_hz)));
+    out.sort_by(|a, b| {
+        a.mu_from
+            .total_cmp(&b.mu_from)
+            .then(a.freq_hz.total_cmp(&b.freq_hz))
+    });
     out
 }
 
@@ -360,7 +364,10 @@ mod tests {
         ck.append(&pts[1]).unwrap();
         // a crash mid-write leaves half a line
         use std::io::Write;
-        let mut f = std::fs::OpenOptions::new().append(true).open(&path).unwrap();
+        let mut f = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .unwrap();
         write!(f, "{{\"mu\": 0.2, \"act").unwrap();
         let back = ck.load().unwrap();
         assert_eq!(back, pts[..2].to_vec());

@@ -11,7 +11,8 @@
 //! duplicates, O(nnz)) and `F_X = T^T P~t^T E_s X T` (the slave-normal rows of `X`,
 //! columns relabelled, scattered with weights `+e_i` into the in-plane rows of the pin
 //! node and `-e_i` into those of the disc node: `4 nc` rows touched), so that
-//! `X~_c(mu) = X_c - mu F_X` costs nothing per mu. `T` is never a matrix.
+//! `X~_c(mu) = X_c - mu F_X` costs nothing per mu. `T` is never a matrix. The friction load
+//! directions `U = T^T P~t^T` (`F_X = U V_X^T`) are kept too, for reduction bases.
 //!
 //! Assumes the normals are `+e_z` (flat disc face) and `X` symmetric (rows of `X` are
 //! read as its columns).
@@ -97,6 +98,25 @@ pub fn build_operator(
             message: format!("F_X: {e:?}"),
         })
     };
+    // U = T^T P~t^T: one column per active pair, +e_i on the pin's in-plane DOFs and
+    // -e_i on the disc's (the friction load directions, F_X = U V_X^T)
+    let mut loads = Vec::new();
+    for (col, i) in (0..set.len()).filter(|&i| active[i]).enumerate() {
+        let (s, md, e) = (set.pin_dofs[i], set.disc_dofs[i], set.direction[i]);
+        for a in 0..2 {
+            if e[a] != 0.0 {
+                loads.push(Triplet::new(t[s[a]], col, e[a]));
+                loads.push(Triplet::new(t[md[a]], col, -e[a]));
+            }
+        }
+    }
+    let n_active = active.iter().filter(|&&a| a).count();
+    let friction_loads = SparseMat::try_new_from_triplets(nc, n_active, &loads).map_err(|e| {
+        ContactError::Setup {
+            field: "operator".into(),
+            message: format!("U = T^T P~t^T: {e:?}"),
+        }
+    })?;
     Ok(FrictionalOperator {
         mc: relabel(m)?,
         cc: c.map(relabel).transpose()?,
@@ -105,5 +125,6 @@ pub fn build_operator(
         fc: c.map(friction).transpose()?,
         fk: friction(k)?,
         t: Some(t),
+        friction_loads: Some(friction_loads),
     })
 }

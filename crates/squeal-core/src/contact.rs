@@ -7,6 +7,7 @@
 //! the pin along `+e_i`. The static sliding equilibrium solves
 //! `K U = F + (Pn + mu Pt)^T Rn`, `0 <= Rn ⟂ g0 + Pn U >= 0`.
 
+use crate::eigen::{EigenParams, EigenSolver};
 use crate::linalg::{add_scaled, norm2, spmv, Cholesky};
 use crate::qep::Qep;
 use crate::{Error, Result, SparseMat, SparseRef};
@@ -120,6 +121,12 @@ pub struct FrictionalOperator {
     /// `t[j]` (an eliminated pin-normal DOF points at its disc partner). `None` when the
     /// operator was given directly (then the operator's DOFs are the full DOFs).
     pub t: Option<Vec<usize>>,
+    /// The friction load directions `U = T^T P~t^T` (`n_c x nA`, one column per active
+    /// pair: `+e_i` on the pin node's in-plane DOFs, `-e_i` on the disc node's), of which
+    /// every friction part is a product `F_X = U V_X^T`. Reduction bases use them (static
+    /// responses `K_c^-1 U`). `None` when unknown (an operator read from files);
+    /// [`crate::reduction::friction_load_directions`] then recovers their span from `F_K`.
+    pub friction_loads: Option<SparseMat>,
 }
 
 impl FrictionalOperator {
@@ -161,26 +168,86 @@ impl FrictionalOperator {
     }
 }
 
-/// A real reduction basis on the constrained space, `M_c`-orthonormal.
+/// A real reduction basis on the constrained space, `M_c`-orthonormal
+/// (`V^T M_c V = I` to round-off), with how it was built.
 #[derive(Debug, Clone)]
 pub struct Basis {
     /// Columns of the basis (`n_c x m`).
     pub v: Mat<f64>,
     /// Wall time to build it (s).
     pub time_s: f64,
-    /// Vectors removed by the rank cut.
+    /// Candidate vectors removed by the rank cut (and the optional SVD compression).
     pub dropped: usize,
     /// Iterations (iterative bases), else 0.
     pub iterations: usize,
+    /// Friction coefficient the basis was built for; `None` when it does not depend on mu
+    /// (valid for every mu of the contact set).
+    pub mu: Option<f64>,
+    /// Final convergence measure of an iterative basis (the residue method's largest
+    /// energy-norm residual of its target modes); `None` otherwise.
+    pub residual: Option<f64>,
+    /// Anything the user should know (what the columns are, non-convergence, ...).
+    pub notes: Vec<String>,
+}
+
+impl Basis {
+    /// A basis of columns `v` (assumed `M_c`-orthonormal) with empty bookkeeping.
+    pub fn new(v: Mat<f64>) -> Self {
+        Self {
+            v,
+            time_s: 0.0,
+            dropped: 0,
+            iterations: 0,
+            mu: None,
+            residual: None,
+            notes: Vec::new(),
+        }
+    }
+
+    /// Number of columns `m`.
+    pub fn len(&self) -> usize {
+        self.v.ncols()
+    }
+
+    /// Whether the basis has no column.
+    pub fn is_empty(&self) -> bool {
+        self.v.ncols() == 0
+    }
+}
+
+/// Everything a [`ReductionBasis`] may use to build its basis.
+#[derive(Clone, Copy)]
+pub struct BasisRequest<'a> {
+    /// The full frictional operator of the contact set.
+    pub op: &'a FrictionalOperator,
+    /// Friction coefficient (bases fixed in mu ignore it).
+    pub mu: f64,
+    /// Frequency band of the stability analysis `(fmin, fmax)` (Hz).
+    pub band_hz: (f64, f64),
+    /// Solver of the full-order symmetric problems a basis needs (the coupled mu = 0
+    /// real modes of `(K_c, M_c)`): normally a sparse backend (`arpack`, `krylov`).
+    pub modal: &'a dyn EigenSolver,
+    /// Solver of the reduced (projected) QEPs an iterative basis solves: normally `dense`.
+    pub reduced: &'a dyn EigenSolver,
+    /// Tolerances and limits handed to both solvers (their band fields are overridden).
+    pub params: &'a EigenParams,
 }
 
 /// Builds a reduction basis for one frictional operator.
+///
+/// The shared machinery (orthonormalization with a rank cut, projection, reduced solve,
+/// expansion, backward errors on the full operator) lives in [`crate::reduction`]; a basis
+/// only chooses its vectors.
 pub trait ReductionBasis: Send + Sync {
     /// Plugin name (as registered).
     fn name(&self) -> &str;
-    /// Builds the basis for friction coefficient `mu` and band `(fmin, fmax)` in Hz;
-    /// bases fixed in mu ignore `mu`.
-    fn build(&self, op: &FrictionalOperator, mu: f64, band_hz: (f64, f64)) -> Result<Basis>;
+    /// Whether the basis depends on mu. `false` (the default) means it is built once per
+    /// contact set and reused across a whole mu sweep.
+    fn depends_on_mu(&self) -> bool {
+        false
+    }
+    /// Builds the basis described by `request`.
+    fn build(&self, request: &BasisRequest<'_>) -> Result<Basis>;
 }
 
 /// The contact problem condensed on the pairs after one Cholesky factorization of `K`:

@@ -8,7 +8,8 @@
 //!   [`SolveInfo`]);
 //! - [`Params`], the name/value parameters a plugin is built from;
 //! - the [`Registry`] that maps plugin names to constructors;
-//! - shared numerical machinery that every backend uses the same way ([`linalg`]).
+//! - shared numerical machinery that every backend uses the same way ([`linalg`], [`qep`],
+//!   and [`reduction`] for the reduction bases).
 //!
 //! Units: SI throughout (m, kg, s, N, Pa); frequencies in Hz, eigenvalues of the
 //! symmetric problem `K x = omega^2 M x` in (rad/s)^2.
@@ -21,9 +22,12 @@ pub mod linalg;
 pub mod material;
 pub mod params;
 pub mod qep;
+pub mod reduction;
 pub mod registry;
 
-pub use contact::{ContactLaw, EquilibriumSolver, FrictionalOperator, ReductionBasis};
+pub use contact::{
+    Basis, BasisRequest, ContactLaw, EquilibriumSolver, FrictionalOperator, ReductionBasis,
+};
 pub use eigen::{
     solve_symmetric_band, EigenParams, EigenSolver, KernelOutput, RealModes, SolveInfo, StopReason,
     SymmetricKernel, SymmetricProblem,
@@ -35,6 +39,7 @@ pub use qep::{
     dense_qep, solve_qep_band, ComplexKernel, ComplexKernelOutput, ComplexLinOp, ComplexModes, Qep,
     QepShiftInvert, QepSymbolic,
 };
+pub use reduction::{solve_reduced, ReducedOperator, ReducedSolve};
 pub use registry::Registry;
 
 pub use faer;

@@ -116,6 +116,7 @@ pub fn read_operator_dir(dir: impl AsRef<Path>) -> Result<FrictionalOperator, Io
         fc,
         fk,
         t,
+        friction_loads: None,
     })
 }
 

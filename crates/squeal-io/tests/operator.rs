@@ -63,6 +63,7 @@ fn hoffmann() -> FrictionalOperator {
         fc: None,
         fk: mat(2, &[(0, 1, 1.0)]),
         t: None,
+        friction_loads: None,
     }
 }
 
@@ -184,6 +185,7 @@ fn full_operator() -> FrictionalOperator {
         fc: Some(mat(4, &[(2, 1, 2e-5)])),
         fk: mat(4, &[(2, 0, -4.4e6), (3, 1, 1.0e6 / 3.0)]),
         t: Some(vec![0, 1, 2, 3, 2]),
+        friction_loads: None,
     }
 }
 

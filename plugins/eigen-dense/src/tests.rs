@@ -83,6 +83,7 @@ fn hoffmann() -> FrictionalOperator {
         fc: None,
         fk: sparse(2, &[(0, 1, 1.0)]),
         t: None,
+        friction_loads: None,
     }
 }
 

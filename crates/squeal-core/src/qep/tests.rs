@@ -181,6 +181,7 @@ fn hoffmann() -> FrictionalOperator {
         fc: None,
         fk: sparse(&dense_of(&[&[0.0, 1.0], &[0.0, 0.0]])),
         t: None,
+        friction_loads: None,
     }
 }
 

@@ -1,0 +1,359 @@
+use super::*;
+use crate::eigen::{dense_symmetric, finish_real_modes, SolveInfo, StopReason};
+use crate::qep::{backward_error, dense_qep, Qep};
+
+/// Deterministic pseudo-random numbers in [-0.5, 0.5).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
+    fn mat(&mut self, r: usize, c: usize) -> Mat<f64> {
+        Mat::from_fn(r, c, |_, _| self.next())
+    }
+}
+
+fn sparse(a: MatRef<'_, f64>) -> SparseMat {
+    dense_to_sparse(a).unwrap()
+}
+
+/// A small frictional operator: `M`, `K` symmetric positive definite (banded), friction
+/// parts of rank `na`, `F_X = U V_X^T` (`V_M^T` = rows of `M` at `na` "slave" DOFs, `V_K^T`
+/// rows of another stiffness), the friction loads stored or not.
+fn operator(n: usize, na: usize, with_loads: bool, seed: u64) -> FrictionalOperator {
+    let mut rng = Rng(seed);
+    // delocalized modes: K = 1e6 (B B^T + n I), M = I + 0.1 B' B'^T / n
+    let b = rng.mat(n, n);
+    let bm = rng.mat(n, n);
+    let k = (&b * b.transpose() + Mat::<f64>::identity(n, n) * faer::Scale(n as f64))
+        * faer::Scale(1e6);
+    let m = Mat::<f64>::identity(n, n) + &bm * bm.transpose() * faer::Scale(0.1 / n as f64);
+    let mut u = Mat::<f64>::zeros(n, na);
+    for p in 0..na {
+        let (a, b) = ((3 * p + 1) % n, (3 * p + 2) % n);
+        u[(a, p)] = 0.8;
+        u[(b, p)] = -0.6;
+    }
+    let slave: Vec<usize> = (0..na).map(|p| (3 * p) % n).collect();
+    let rows = |x: &Mat<f64>| Mat::from_fn(na, n, |i, j| x[(slave[i], j)]);
+    let fm = &u * rows(&m);
+    // rows of another stiffness: with the rows of K itself, K~ = (I - mu U L) K and the
+    // spectrum would not depend on mu (the constraint T is what makes friction bite)
+    let b2 = rng.mat(n, n);
+    let k2 = &b2 * b2.transpose() * faer::Scale(1e6);
+    let fk = &u * rows(&k2);
+    FrictionalOperator {
+        mc: sparse(m.as_ref()),
+        cc: None,
+        kc: sparse(k.as_ref()),
+        fm: sparse(fm.as_ref()),
+        fc: None,
+        fk: sparse(fk.as_ref()),
+        t: None,
+        friction_loads: with_loads.then(|| sparse(u.as_ref())),
+    }
+}
+
+/// The `dense` solver's behaviour, inline (core cannot depend on the plugin).
+struct Dense;
+impl EigenSolver for Dense {
+    fn name(&self) -> &str {
+        "dense-test"
+    }
+    fn solve_symmetric(
+        &self,
+        problem: &SymmetricProblem<'_>,
+        params: &EigenParams,
+    ) -> Result<RealModes> {
+        let (w, v) = dense_symmetric(problem)?;
+        Ok(finish_real_modes(problem, &w, v.as_ref(), params, info()))
+    }
+    fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {
+        let (l, v) = dense_qep(qep)?;
+        finish_modes(qep, &l, v.as_ref(), params, info())
+    }
+}
+
+fn info() -> SolveInfo {
+    SolveInfo {
+        solver: "dense-test".into(),
+        time_s: 0.0,
+        requested: 0,
+        converged: 0,
+        iterations: 0,
+        op_applications: 0,
+        factorizations: 0,
+        reason: StopReason::Converged,
+        notes: vec![],
+    }
+}
+
+fn wide_band() -> EigenParams {
+    EigenParams {
+        fmin_hz: 0.0,
+        fmax_hz: 1e6,
+        ..EigenParams::default()
+    }
+}
+
+/// Largest distance from each eigenvalue of `a` to its nearest unused one in `b`,
+/// relative to the largest `|lambda|`.
+fn spectral_distance(a: &[c64], b: &[c64]) -> f64 {
+    assert_eq!(a.len(), b.len(), "spectra of different sizes");
+    let scale = b.iter().fold(0.0f64, |m, z| m.max(z.norm()));
+    let mut used = vec![false; b.len()];
+    let mut worst = 0.0f64;
+    for x in a {
+        let (j, d) = b
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| !used[*j])
+            .map(|(j, y)| (j, (x - y).norm()))
+            .min_by(|p, q| p.1.total_cmp(&q.1))
+            .unwrap();
+        used[j] = true;
+        worst = worst.max(d);
+    }
+    worst / scale
+}
+
+#[test]
+fn orthonormalization_keeps_a_badly_scaled_static_vector_nearly_parallel_to_a_mode() {
+    let op = operator(40, 3, true, 7);
+    let m = op.mc.as_ref();
+    let mut rng = Rng(11);
+    let (modes, d0) = m_orthonormalize(m, rng.mat(40, 10).as_ref(), DEFAULT_RANK_TOL).unwrap();
+    assert_eq!((modes.ncols(), d0), (10, 0));
+    assert!(m_orthonormality_error(m, modes.as_ref()) < 1e-13);
+    // a direction M-orthogonal to the modes
+    let (all, _) =
+        m_orthonormal_extend(m, modes.as_ref(), rng.mat(40, 1).as_ref(), DEFAULT_RANK_TOL).unwrap();
+    let z: Vec<f64> = (0..40).map(|r| all[(r, 10)]).collect();
+    // static vectors of size 1e-9 (a displacement in m), at angles 1e-6 and 1e-13 from
+    // mode 0, plus a zero column
+    let near = |angle: f64| -> Vec<f64> {
+        (0..40)
+            .map(|r| 1e-9 * (modes[(r, 0)] + angle * z[r]))
+            .collect()
+    };
+    let (a, b) = (near(1e-6), near(1e-13));
+    let new = Mat::from_fn(40, 3, |r, c| match c {
+        0 => a[r],
+        1 => b[r],
+        _ => 0.0,
+    });
+    let (v, dropped) = m_orthonormal_extend(m, modes.as_ref(), new.as_ref(), 1e-10).unwrap();
+    assert_eq!(
+        v.ncols(),
+        11,
+        "the near-parallel static vector must survive"
+    );
+    assert_eq!(
+        dropped, 2,
+        "the 1e-13 one and the zero column are dropped and counted"
+    );
+    assert!(m_orthonormality_error(m, v.as_ref()) < 1e-12);
+    // the kept direction is the new part of the static vector, z (up to sign)
+    let kept: Vec<f64> = (0..40).map(|r| v[(r, 10)]).collect();
+    let mut mz = vec![0.0; 40];
+    spmv(m, &z, &mut mz);
+    let cos = dot(&kept, &mz).abs();
+    assert!((cos - 1.0).abs() < 1e-6, "cos = {cos}");
+    // the modes are unchanged (first, bit for bit)
+    for c in 0..10 {
+        for r in 0..40 {
+            assert_eq!(v[(r, c)], modes[(r, c)]);
+        }
+    }
+    // the raw-Gram pitfall: the Gram matrix of the unscaled columns [modes | a] has its
+    // smallest eigenvalue near (1e-9 * 1e-6)^2 relative to 1: a relative eigenvalue cut
+    // at the same 1e-10 would drop the static vector
+    let cols = Mat::from_fn(40, 11, |r, c| if c < 10 { modes[(r, c)] } else { a[r] });
+    let g = tmul(cols.as_ref(), sparse_times(m, cols.as_ref()).as_ref());
+    let ev = g.self_adjoint_eigenvalues(faer::Side::Lower).unwrap();
+    let (lo, hi) = (ev[0], ev[ev.len() - 1]);
+    assert!(lo < 1e-10 * hi, "{lo:e} vs {hi:e}");
+}
+
+#[test]
+fn svd_compression_keeps_the_dominant_directions() {
+    let op = operator(30, 2, true, 3);
+    let m = op.mc.as_ref();
+    let mut rng = Rng(5);
+    let ab = rng.mat(30, 2);
+    // columns: a, b, a + b + 1e-4 c, 1e3 a (same direction as a)
+    let c = rng.mat(30, 1);
+    let v = Mat::from_fn(30, 4, |r, j| match j {
+        0 => ab[(r, 0)],
+        1 => ab[(r, 1)],
+        2 => ab[(r, 0)] + ab[(r, 1)] + 1e-4 * c[(r, 0)],
+        _ => 1e3 * ab[(r, 0)],
+    });
+    let (q, dropped) = m_svd_compress(m, v.as_ref(), 1e-2).unwrap();
+    assert_eq!((q.ncols(), dropped), (2, 2));
+    assert!(m_orthonormality_error(m, q.as_ref()) < 1e-13);
+    let (q, dropped) = m_svd_compress(m, v.as_ref(), 1e-8).unwrap();
+    assert_eq!((q.ncols(), dropped), (3, 1));
+    assert!(m_svd_compress(m, v.as_ref(), 0.0).is_err());
+}
+
+#[test]
+fn identity_and_full_rank_bases_reproduce_the_full_dense_spectrum() {
+    let op = operator(24, 4, true, 21);
+    for mu in [0.3, 0.7] {
+        let full = op.at(mu).unwrap();
+        let (lam, _) = dense_qep(&full).unwrap();
+        let reference = finish_modes(
+            &full,
+            &lam,
+            dense_qep(&full).unwrap().1.as_ref(),
+            &wide_band(),
+            info(),
+        )
+        .unwrap();
+        assert!(reference.len() >= 10);
+        // V = I: the projection is the operator itself
+        let eye = Basis::new(Mat::<f64>::identity(24, 24));
+        let red = solve_reduced(&op, &eye, mu, &Dense, &wide_band()).unwrap();
+        assert_eq!(red.basis_size, 24);
+        let d = spectral_distance(&red.modes.lambda, &reference.lambda);
+        assert!(d < 1e-12, "mu {mu}: identity basis differs by {d:e}");
+        // a random M-orthonormal basis of full rank: the same spectrum (congruence)
+        let (v, dropped) = m_orthonormalize(
+            op.mc.as_ref(),
+            Rng(99).mat(24, 24).as_ref(),
+            DEFAULT_RANK_TOL,
+        )
+        .unwrap();
+        assert_eq!(dropped, 0);
+        let basis = Basis::new(v);
+        let red = solve_reduced(&op, &basis, mu, &Dense, &wide_band()).unwrap();
+        let d = spectral_distance(&red.modes.lambda, &reference.lambda);
+        assert!(d < 1e-10, "mu {mu}: rotated basis differs by {d:e}");
+        let worst = red
+            .modes
+            .backward_error
+            .iter()
+            .fold(0.0f64, |a, &b| a.max(b));
+        assert!(worst < 1e-12, "mu {mu}: backward error {worst:e}");
+        // the reduced operator keeps the parts apart: F_r = V^T U V_K^T V
+        let r = project(&op, basis.v.as_ref()).unwrap();
+        assert!(r.t.is_none());
+        assert_eq!(r.friction_loads.as_ref().unwrap().ncols(), 4);
+        assert!(mac_sanity(&op, &red.modes));
+    }
+}
+
+/// Every expanded mode has unit MAC with itself.
+fn mac_sanity(op: &FrictionalOperator, modes: &ComplexModes) -> bool {
+    let n = op.dim();
+    (0..modes.len()).all(|j| {
+        let psi: Vec<c64> = (0..n).map(|r| modes.vectors[(r, j)]).collect();
+        let re: Vec<f64> = psi.iter().map(|z| z.re).collect();
+        mac_real_complex(op.mc.as_ref(), &re, &psi) <= 1.0 + 1e-12
+    })
+}
+
+#[test]
+fn backward_error_flags_a_perturbed_mode_and_a_truncated_basis() {
+    let op = operator(30, 3, true, 5);
+    let mu = 0.5;
+    let full = op.at(mu).unwrap();
+    let (lam, vec) = dense_qep(&full).unwrap();
+    let modes = finish_modes(&full, &lam, vec.as_ref(), &wide_band(), info()).unwrap();
+    let j = modes.len() / 2;
+    let u: Vec<c64> = (0..30).map(|r| modes.vectors[(r, j)]).collect();
+    let exact = backward_error(&full, modes.lambda[j], &u);
+    assert!(exact < 1e-13, "exact mode: {exact:e}");
+    let mut rng = Rng(17);
+    let bent: Vec<c64> = u
+        .iter()
+        .map(|z| z + c64::new(1e-4 * rng.next(), 1e-4 * rng.next()))
+        .collect();
+    let perturbed = backward_error(&full, modes.lambda[j], &bent);
+    assert!(perturbed > 1e-7, "perturbed mode: {perturbed:e}");
+    let shifted = backward_error(&full, modes.lambda[j] * 1.001, &u);
+    assert!(shifted > 1e-5, "shifted eigenvalue: {shifted:e}");
+    // a basis of the 8 lowest real modes misses part of every mode: the backward error
+    // on the full operator says so
+    let req = BasisRequest {
+        op: &op,
+        mu,
+        band_hz: (0.0, 1e6),
+        modal: &Dense,
+        reduced: &Dense,
+        params: &wide_band(),
+    };
+    let rm = coupled_real_modes(&req, 1e6).unwrap();
+    let v8 = rm.vectors.as_ref().subcols(0, 8).to_owned();
+    let red = solve_reduced(&op, &Basis::new(v8), mu, &Dense, &wide_band()).unwrap();
+    let worst = red
+        .modes
+        .backward_error
+        .iter()
+        .fold(0.0f64, |a, &b| a.max(b));
+    assert!(
+        worst > 1e-6,
+        "truncated basis: largest backward error {worst:e}"
+    );
+}
+
+#[test]
+fn friction_load_span_is_recovered_from_fk() {
+    let with = operator(36, 4, true, 8);
+    let mut without = with.clone();
+    without.friction_loads = None;
+    let u = friction_load_directions(&with).unwrap();
+    assert_eq!(u.ncols(), 4);
+    let y = friction_load_directions(&without).unwrap();
+    let m = with.mc.as_ref();
+    let (q, _) = m_orthonormalize(m, u.as_ref(), DEFAULT_RANK_TOL).unwrap();
+    let (all, dropped) = m_orthonormal_extend(m, q.as_ref(), y.as_ref(), 1e-8).unwrap();
+    assert_eq!(all.ncols(), 4, "span(F_K Omega) must lie in span(U)");
+    assert_eq!(dropped, y.ncols());
+    let (qy, _) = m_orthonormalize(m, y.as_ref(), 1e-8).unwrap();
+    assert_eq!(qy.ncols(), 4, "and fill it");
+}
+
+#[test]
+fn energy_residual_vanishes_on_exact_modes_only() {
+    let op = operator(20, 2, true, 13);
+    let mu = 0.4;
+    let full = op.at(mu).unwrap();
+    let (lam, vec) = dense_qep(&full).unwrap();
+    let modes = finish_modes(&full, &lam, vec.as_ref(), &wide_band(), info()).unwrap();
+    let ks = StaticSolver::new(&op, 0.0).unwrap();
+    let (eps, d) = energy_residuals(&full, &ks, &modes.lambda, modes.vectors.as_ref());
+    assert_eq!(d.ncols(), modes.len());
+    assert!(eps.iter().all(|&e| e < 1e-12), "{eps:?}");
+    let mut rng = Rng(2);
+    let bent = Mat::from_fn(20, modes.len(), |r, c| {
+        modes.vectors[(r, c)] + c64::new(1e-3 * rng.next(), 0.0)
+    });
+    let (eps, _) = energy_residuals(&full, &ks, &modes.lambda, bent.as_ref());
+    assert!(eps.iter().all(|&e| e > 1e-6), "{eps:?}");
+}
+
+#[test]
+fn mac_is_phase_independent() {
+    let op = operator(12, 1, false, 4);
+    let mut rng = Rng(6);
+    let phi: Vec<f64> = (0..12).map(|_| rng.next()).collect();
+    let rot = c64::new(0.6, -0.8);
+    let psi: Vec<c64> = phi.iter().map(|&x| rot * x * 3.0).collect();
+    let mac = mac_real_complex(op.mc.as_ref(), &phi, &psi);
+    assert!((mac - 1.0).abs() < 1e-14, "{mac}");
+    let other: Vec<f64> = (0..12).map(|_| rng.next()).collect();
+    let (q, _) = m_orthonormalize(
+        op.mc.as_ref(),
+        Mat::from_fn(12, 2, |r, c| if c == 0 { phi[r] } else { other[r] }).as_ref(),
+        DEFAULT_RANK_TOL,
+    )
+    .unwrap();
+    let orth: Vec<c64> = (0..12).map(|r| rot * q[(r, 1)]).collect();
+    let mac = mac_real_complex(op.mc.as_ref(), &phi, &orth);
+    assert!(mac < 1e-24, "{mac}");
+}

@@ -1,0 +1,138 @@
+//! # squeal-basis-enriched
+//!
+//! The enriched real coupled basis (the paper's ref. 40), registered as `"enriched"`:
+//! the coupled mu = 0 real modes of `(K_c, M_c)` up to `cutoff_factor x` the band top,
+//! plus the static responses to the friction loads `K_c^-1 U`, `U = T^T P~t^T` (one
+//! vector per active pair), optionally compressed by an SVD in the `M_c` inner product.
+//! Everything is `M_c`-orthonormalized with the rank cut of
+//! [`squeal_core::reduction`] (columns scaled to unit `M_c` norm first, so the static
+//! vectors, of order 1e-9 m per N, survive next to unit-modal-mass modes).
+//!
+//! Fixed in mu, not in contact set: built once per contact set (a new active set means
+//! a new `T` and a new basis) and reused across a whole mu sweep
+//! ([`ReductionBasis::depends_on_mu`] is `false`).
+//!
+//! ## Parameters
+//!
+//! - `cutoff_factor` (default 1.5, > 0): modes up to `cutoff_factor * band top`.
+//! - `svd_tol` (default: none, no compression): keep the left singular vectors of the
+//!   `M_c`-normalized static responses with singular value `> svd_tol * sigma_max`.
+//! - `rank_tol` (default [`DEFAULT_RANK_TOL`]): relative rank cut of the
+//!   orthonormalization.
+
+use squeal_core::linalg::norm2;
+use squeal_core::reduction::{
+    coupled_real_modes, friction_load_directions, m_orthonormal_extend, m_orthonormalize,
+    m_svd_compress, StaticSolver, DEFAULT_RANK_TOL,
+};
+use squeal_core::{Basis, BasisRequest, Error, Params, ReductionBasis, Registry, Result};
+use std::time::Instant;
+
+/// Name under which the basis is registered.
+pub const NAME: &str = "enriched";
+
+/// One-line description shown by the registry.
+pub const DESCRIPTION: &str = "real modes up to cutoff_factor x band top (default 1.5) plus \
+                               static responses to the friction loads (one per active \
+                               pair); options cutoff_factor, svd_tol, rank_tol";
+
+/// Default of the `cutoff_factor` parameter.
+pub const DEFAULT_CUTOFF_FACTOR: f64 = 1.5;
+
+/// Registers the `"enriched"` basis.
+pub fn register(reg: &mut Registry) {
+    reg.bases.register(NAME, DESCRIPTION, |params: &Params| {
+        params.reject_unknown(NAME, &["cutoff_factor", "svd_tol", "rank_tol"])?;
+        let svd_tol = if params.0.contains_key("svd_tol") {
+            Some(params.num("svd_tol")?)
+        } else {
+            None
+        };
+        let basis: Box<dyn ReductionBasis> = Box::new(EnrichedBasis::new(
+            params.num_or("cutoff_factor", DEFAULT_CUTOFF_FACTOR)?,
+            svd_tol,
+            params.num_or("rank_tol", DEFAULT_RANK_TOL)?,
+        )?);
+        Ok(basis)
+    });
+}
+
+/// The `"enriched"` basis.
+#[derive(Debug, Clone)]
+pub struct EnrichedBasis {
+    /// Cutoff frequency of the modes over band top.
+    pub cutoff_factor: f64,
+    /// Relative singular value cut of the static responses; `None`: no compression.
+    pub svd_tol: Option<f64>,
+    /// Relative rank cut of the orthonormalization.
+    pub rank_tol: f64,
+}
+
+impl EnrichedBasis {
+    /// Checks and stores the parameters.
+    pub fn new(cutoff_factor: f64, svd_tol: Option<f64>, rank_tol: f64) -> Result<Self> {
+        if !(cutoff_factor.is_finite() && cutoff_factor > 0.0) {
+            return Err(Error::param(
+                "cutoff_factor",
+                format!("must be a positive number, got {cutoff_factor}"),
+            ));
+        }
+        for (name, v) in [("svd_tol", svd_tol.unwrap_or(0.5)), ("rank_tol", rank_tol)] {
+            if !(v > 0.0 && v < 1.0) {
+                return Err(Error::param(name, format!("must be in (0, 1), got {v}")));
+            }
+        }
+        Ok(Self {
+            cutoff_factor,
+            svd_tol,
+            rank_tol,
+        })
+    }
+}
+
+impl ReductionBasis for EnrichedBasis {
+    fn name(&self) -> &str {
+        NAME
+    }
+
+    fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {
+        let start = Instant::now();
+        let op = request.op;
+        let mc = op.mc.as_ref();
+        let cutoff = self.cutoff_factor * request.band_hz.1;
+        let modes = coupled_real_modes(request, cutoff)?;
+        let (vm, dropped_modes) = m_orthonormalize(mc, modes.vectors.as_ref(), self.rank_tol)?;
+        // static responses K_c^-1 U, one per active pair
+        let mut statics = friction_load_directions(op)?;
+        let loads = statics.ncols();
+        let ks = StaticSolver::new(op, 0.0)?;
+        ks.solve_in_place(statics.as_mut());
+        let finite = (0..statics.ncols())
+            .all(|c| norm2(statics.col(c).try_as_col_major().unwrap().as_slice()).is_finite());
+        if !finite {
+            return Err(Error::Invalid(
+                "enriched basis: non-finite static response (singular K_c?)".into(),
+            ));
+        }
+        let (statics, dropped_svd) = match self.svd_tol {
+            Some(tol) => m_svd_compress(mc, statics.as_ref(), tol)?,
+            None => (statics, 0),
+        };
+        let (v, dropped_static) =
+            m_orthonormal_extend(mc, vm.as_ref(), statics.as_ref(), self.rank_tol)?;
+        let mut basis = Basis::new(v);
+        basis.dropped = dropped_modes + dropped_svd + dropped_static;
+        basis.notes.push(format!(
+            "{NAME}: {} real modes up to {cutoff:.1} Hz (`{}`) + {} static vectors of {loads} \
+             friction loads ({} removed by the SVD cut{}, {} by the rank cut)",
+            vm.ncols(),
+            request.modal.name(),
+            basis.len() - vm.ncols(),
+            dropped_svd,
+            self.svd_tol.map_or(String::new(), |t| format!(" at {t:e}")),
+            dropped_static
+        ));
+        basis.time_s = start.elapsed().as_secs_f64();
+        Ok(basis)
+    }
+}
