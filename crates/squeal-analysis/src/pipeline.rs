@@ -298,3 +298,100 @@ pub fn run_mu_sweep(
     }
     Ok(points)
 }
+
+/// How the complex modes of an operator are computed: full order with one eigen solver,
+/// or through a reduction basis (projected once per contact set when the basis does not
+/// depend on mu) and a reduced solver. One object serves a whole sweep.
+pub struct Method {
+    /// `none` or the basis plugin name.
+    pub basis_name: String,
+    /// Eigen solver name (of the reduced problem when there is a basis).
+    pub eigen_name: String,
+    basis: Option<Box<dyn squeal_core::ReductionBasis>>,
+    eigen: Box<dyn EigenSolver>,
+    modal: Box<dyn EigenSolver>,
+    params: EigenParams,
+    cached: Option<squeal_core::reduction::ReducedOperator>,
+}
+
+impl Method {
+    /// `basis = "none"` for full order; `basis_params` go to the basis plugin; `modal` is
+    /// the sparse symmetric solver a basis uses for its real modes.
+    pub fn new(
+        registry: &Registry,
+        basis: &str,
+        basis_params: &Params,
+        eigen: &str,
+        modal: &str,
+        params: EigenParams,
+    ) -> Result<Self> {
+        let b = if basis == "none" {
+            None
+        } else {
+            Some(
+                registry
+                    .bases
+                    .create(basis, basis_params)
+                    .map_err(core("reduction basis"))?,
+            )
+        };
+        Ok(Self {
+            basis_name: basis.to_string(),
+            eigen_name: eigen.to_string(),
+            basis: b,
+            eigen: registry
+                .eigen
+                .create(eigen, &Params::new())
+                .map_err(core("eigen solver"))?,
+            modal: registry
+                .eigen
+                .create(modal, &Params::new())
+                .map_err(core("modal eigen solver"))?,
+            params,
+            cached: None,
+        })
+    }
+
+    /// The modes of `op` at `mu`; `rebuilt` says the operator changed since the last call
+    /// (a new contact set), which invalidates a cached basis. Returns the modes, the basis
+    /// size (0 for full order) and the time spent on the basis and projection (s).
+    pub fn solve(&mut self, op: &FrictionalOperator, mu: f64, rebuilt: bool) -> Result<StepResult> {
+        let Some(basis) = &self.basis else {
+            let modes = self
+                .eigen
+                .solve_frictional(op, mu, &self.params)
+                .map_err(core(&format!("`{}` at mu = {mu}", self.eigen_name)))?;
+            return Ok((modes, 0, 0.0));
+        };
+        let stale = rebuilt
+            || self.cached.is_none()
+            || (basis.depends_on_mu() && self.cached.as_ref().and_then(|c| c.basis.mu) != Some(mu));
+        let mut setup = 0.0;
+        if stale {
+            let t = Instant::now();
+            let req = squeal_core::contact::BasisRequest {
+                op,
+                mu,
+                band_hz: (self.params.fmin_hz, self.params.fmax_hz),
+                modal: self.modal.as_ref(),
+                reduced: self.eigen.as_ref(),
+                params: &self.params,
+            };
+            let b = basis
+                .build(&req)
+                .map_err(core(&format!("basis `{}` at mu = {mu}", self.basis_name)))?;
+            self.cached = Some(
+                squeal_core::reduction::ReducedOperator::new(op, b)
+                    .map_err(core("projection on the basis"))?,
+            );
+            setup = t.elapsed().as_secs_f64();
+        }
+        let red = self
+            .cached
+            .as_ref()
+            .expect("basis built")
+            .solve(op, mu, self.eigen.as_ref(), &self.params)
+            .map_err(core(&format!("reduced solve at mu = {mu}")))?;
+        Ok((red.modes, red.basis_size, setup))
+    }
+}

@@ -5,6 +5,7 @@ mod modes;
 mod scene_cmd;
 mod stability;
 mod sweep;
+mod validate;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -51,15 +52,31 @@ enum Command {
         #[arg(long)]
         vtu: Option<std::path::PathBuf>,
     },
-    /// The main job: the uniform-contact validation on the embedded default scene
-    /// (for now: the disc's normal modes against Table 2 of the paper).
+    /// The main job: the uniform-contact validation on the embedded default scene: disc
+    /// modes vs Table 2, sliding equilibria, the mu sweep through two bases, full-order
+    /// reference points, report.md/report.json and a paper-vs-squeal table.
     Validate {
         /// Scene file or embedded name.
         scene: Option<String>,
-        /// Eigen solver plugin.
+        /// Report directory.
+        #[arg(long, default_value = "out/validate")]
+        out: std::path::PathBuf,
+        /// Step of the mu sweep (0 to 0.8).
+        #[arg(long, default_value_t = 0.05)]
+        step: f64,
+        /// Reduction bases to sweep with, comma separated.
+        #[arg(long, value_delimiter = ',', default_value = "enriched,residue")]
+        bases: Vec<String>,
+        /// Friction coefficients of the full-order reference solves, comma separated.
+        #[arg(long, value_delimiter = ',', default_value = "0.3,0.7")]
+        reference_mu: Vec<f64>,
+        /// Full-order eigen solver of the reference points.
         #[arg(long, default_value = "arpack")]
         eigen: String,
-        /// Write the report JSON here.
+        /// Only the disc modes against Table 2 (the first stage), as JSON here if given.
+        #[arg(long)]
+        disc_only: bool,
+        /// With --disc-only: write the table as JSON here.
         #[arg(long)]
         json: Option<std::path::PathBuf>,
     },
@@ -96,9 +113,17 @@ enum Command {
         /// Friction coefficient (default: the scene's study.mu; required with --operator).
         #[arg(long)]
         mu: Option<f64>,
-        /// Eigen solver plugin (`arpack`, `krylov`, `dense`).
-        #[arg(long, default_value = "arpack")]
-        eigen: String,
+        /// Eigen solver plugin (`arpack`, `krylov`, `dense`); default `arpack`, or `dense`
+        /// for the reduced problem when a basis is given.
+        #[arg(long)]
+        eigen: Option<String>,
+        /// Reduction basis plugin (`modes`, `enriched`, `residue`, ...) or `none` (full
+        /// order).
+        #[arg(long, default_value = "none")]
+        basis: String,
+        /// Basis parameters `key=value` (e.g. `cutoff_factor=2`).
+        #[arg(long = "basis-opt")]
+        basis_opt: Vec<String>,
         /// Frequency band `FMIN:FMAX` in Hz.
         #[arg(long, default_value = "0:10000")]
         band: String,
@@ -170,9 +195,10 @@ enum SweepKind {
         /// Basis parameters `key=value`.
         #[arg(long = "basis-opt")]
         basis_opt: Vec<String>,
-        /// Eigen solver plugin (of the reduced problem when a basis is given).
-        #[arg(long, default_value = "arpack")]
-        eigen: String,
+        /// Eigen solver plugin; default `arpack`, or `dense` for the reduced problem when
+        /// a basis is given.
+        #[arg(long)]
+        eigen: Option<String>,
         /// Frequency band `FMIN:FMAX` (Hz).
         #[arg(long, default_value = "0:10000")]
         band: String,
@@ -276,7 +302,32 @@ fn run() -> Result<()> {
                 modes::write_json(&report, &path)?;
             }
         }
-        Command::Validate { scene, eigen, json } => {
+        Command::Validate {
+            scene,
+            out,
+            step,
+            bases,
+            reference_mu,
+            eigen,
+            disc_only,
+            json,
+        } if !disc_only => {
+            let _ = json;
+            validate::run(
+                &registry,
+                &validate::Args {
+                    scene: scene.as_deref(),
+                    out: &out,
+                    step,
+                    bases: &bases,
+                    reference_mu: &reference_mu,
+                    eigen: &eigen,
+                },
+            )?;
+        }
+        Command::Validate {
+            scene, eigen, json, ..
+        } => {
             let report = modes::run(
                 &registry,
                 scene.as_deref(),
@@ -396,11 +447,17 @@ fn run() -> Result<()> {
             equilibrium,
             law,
             json,
+            basis,
+            basis_opt,
         } => {
+            let eigen = eigen
+                .unwrap_or_else(|| if basis == "none" { "arpack" } else { "dense" }.to_string());
             let args = stability::Args {
                 scene: scene.as_deref(),
                 operator: operator.as_deref(),
                 mu,
+                basis: &basis,
+                basis_opts: &basis_opt,
                 eigen: &eigen,
                 band: parse_band(&band)?,
                 tol,
@@ -439,6 +496,8 @@ fn run() -> Result<()> {
                     out,
                 },
         } => {
+            let eigen = eigen
+                .unwrap_or_else(|| if basis == "none" { "arpack" } else { "dense" }.to_string());
             let args = sweep::Args {
                 scene: scene.as_deref(),
                 from,

@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use squeal_analysis::pipeline::{solve_modes, Prepared};
+use squeal_analysis::pipeline::Prepared;
 use squeal_core::{EigenParams, FrictionalOperator, Registry};
 use std::path::Path;
 use std::time::Instant;
@@ -28,6 +28,9 @@ pub struct StabilityReport {
     pub full_dofs: usize,
     pub mu: f64,
     pub eigen: String,
+    pub basis: String,
+    pub basis_size: usize,
+    pub basis_time_s: f64,
     pub band_hz: [f64; 2],
     pub tol: f64,
     pub unstable_tol: f64,
@@ -56,6 +59,8 @@ pub struct Args<'a> {
     pub unstable_tol: f64,
     pub equilibrium: &'a str,
     pub law: &'a str,
+    pub basis: &'a str,
+    pub basis_opts: &'a [String],
 }
 
 /// The operator of a scene at its equilibrium, or read from a directory.
@@ -116,7 +121,15 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
         tol: a.tol,
         ..EigenParams::default()
     };
-    let (modes, _) = solve_modes(registry, &src.op, src.mu, a.eigen, &params)?;
+    let mut method = squeal_analysis::pipeline::Method::new(
+        registry,
+        a.basis,
+        &parse_params(a.basis_opts)?,
+        a.eigen,
+        "arpack",
+        params,
+    )?;
+    let (modes, basis_size, basis_time_s) = method.solve(&src.op, src.mu, true)?;
     let out: Vec<ModeOut> = (0..modes.len())
         .map(|i| ModeOut {
             freq_hz: modes.freq_hz[i],
@@ -134,6 +147,9 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
         full_dofs: src.op.full_dim(),
         mu: src.mu,
         eigen: a.eigen.into(),
+        basis: a.basis.into(),
+        basis_size,
+        basis_time_s,
         band_hz: a.band,
         tol: a.tol,
         unstable_tol: a.unstable_tol,
@@ -154,12 +170,20 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
 
 pub fn print(r: &StabilityReport) {
     println!(
-        "{}: {} DOFs (constrained; {} full), mu = {}, `{}`: {} modes in {:?} Hz in {:.2} s",
+        "{}: {} DOFs (constrained; {} full), mu = {}, `{}`{}: {} modes in {:?} Hz in {:.2} s",
         r.source,
         r.dofs,
         r.full_dofs,
         r.mu,
         r.eigen,
+        if r.basis == "none" {
+            String::new()
+        } else {
+            format!(
+                " on basis `{}` ({} vectors, built in {:.2} s)",
+                r.basis, r.basis_size, r.basis_time_s
+            )
+        },
         r.modes.len(),
         r.band_hz,
         r.solve_time_s
@@ -265,4 +289,14 @@ pub fn export(
         prep.set.len()
     );
     Ok(())
+}
+
+/// Parses `key=value` options into plugin parameters.
+pub fn parse_params(opts: &[String]) -> Result<squeal_core::Params> {
+    let mut p = squeal_core::Params::new();
+    for kv in opts {
+        let (k, v) = squeal_core::Params::parse_kv(kv)?;
+        p.0.insert(k, v);
+    }
+    Ok(p)
 }

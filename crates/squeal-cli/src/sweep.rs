@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use squeal_analysis::pipeline::{run_mu_sweep, solve_modes, FreeModes, Prepared, StepResult};
+use squeal_analysis::pipeline::{run_mu_sweep, FreeModes, Prepared};
 use squeal_analysis::sweep::{
     couplings, track, Branch, Checkpoint, Coupling, SweepPoint, TrackOptions,
 };
@@ -79,26 +79,6 @@ pub fn mus(from: f64, to: f64, step: f64) -> Result<Vec<f64>> {
         .collect())
 }
 
-/// The modes of one sweep point by the chosen method.
-pub fn solver<'a>(
-    registry: &'a Registry,
-    eigen: &'a str,
-    basis: &'a str,
-    basis_opts: &'a [String],
-    params: EigenParams,
-) -> Result<
-    impl FnMut(&FrictionalOperator, f64, bool) -> squeal_analysis::pipeline::Result<StepResult> + 'a,
-> {
-    if basis != "none" {
-        let _ = basis_opts;
-        anyhow::bail!("--basis {basis}: reduction bases are not available in this build yet");
-    }
-    Ok(move |op: &FrictionalOperator, mu: f64, _rebuilt: bool| {
-        let (modes, _) = solve_modes(registry, op, mu, eigen, &params)?;
-        Ok((modes, 0, 0.0))
-    })
-}
-
 pub fn run(registry: &Registry, a: &Args<'_>) -> Result<Summary> {
     let start = Instant::now();
     let mus = mus(a.from, a.to, a.step)?;
@@ -114,7 +94,15 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<Summary> {
         tol: 1e-10,
         ..EigenParams::default()
     };
-    let step = solver(registry, a.eigen, a.basis, a.basis_opts, params)?;
+    let mut method = squeal_analysis::pipeline::Method::new(
+        registry,
+        a.basis,
+        &crate::stability::parse_params(a.basis_opts)?,
+        a.eigen,
+        "arpack",
+        params,
+    )?;
+    let step = |op: &FrictionalOperator, mu: f64, rebuilt: bool| method.solve(op, mu, rebuilt);
     let ckpt = Checkpoint::new(a.out.join("sweep.partial.jsonl"));
     let points = run_mu_sweep(
         &prep,
