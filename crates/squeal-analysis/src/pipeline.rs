@@ -221,6 +221,7 @@ pub fn sweep_point(
         mu,
         active_pairs,
         rebuilt: false,
+        active_hash: 0,
         basis_size: 0,
         times_s: [0.0; 3],
         modes: out,
@@ -232,10 +233,13 @@ pub fn sweep_point(
 pub type StepResult = (ComplexModes, usize, f64);
 
 /// Runs a mu sweep: equilibrium per mu (the contact set may change), the operator rebuilt
-/// only when the active set changes, `solve(op, mu, rebuilt)` for the modes (full order
+/// only when the active set changes, `solve(op, mu, op_changed)` for the modes (full order
 /// or through a basis the closure keeps across calls), signatures on `free`. Points
 /// already in `checkpoint` are not recomputed; each new one is appended before the next
-/// starts. `progress` sees every point.
+/// starts, so a killed run resumes where it stopped. Every point's result depends only on
+/// its mu and contact set (bases fixed in mu depend on the contact set alone), so a resumed
+/// run, or shards over parts of the mu list merged by mu, give the same points as one
+/// uninterrupted run. `progress` sees every point.
 #[allow(clippy::too_many_arguments)]
 pub fn run_mu_sweep(
     prep: &Prepared,
@@ -255,9 +259,10 @@ pub fn run_mu_sweep(
         })?,
         None => Vec::new(),
     };
-    let mut points = Vec::new();
+    let mut points: Vec<crate::sweep::SweepPoint> = Vec::new();
     let mut current: Option<(Vec<bool>, FrictionalOperator)> = None;
     for &mu in mus {
+        let prev_hash = points.last().map(|p| p.active_hash);
         if let Some(p) = done
             .iter()
             .find(|p| (p.mu - mu).abs() <= 1e-12 * (1.0 + mu.abs()))
@@ -270,13 +275,15 @@ pub fn run_mu_sweep(
         let eq = prep.equilibrium(registry, equilibrium, law, mu)?;
         let t_eq = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
-        let rebuilt = !matches!(&current, Some((a, _)) if *a == eq.eq.active);
-        if rebuilt {
+        // a new operator when the contact set changed or none was built in this run (a
+        // resumed sweep or a shard starts without one)
+        let op_changed = !matches!(&current, Some((a, _)) if *a == eq.eq.active);
+        if op_changed {
             current = Some((eq.eq.active.clone(), prep.operator(&eq.eq.active)?));
         }
         let t_op = t1.elapsed().as_secs_f64();
         let op = &current.as_ref().expect("operator built").1;
-        let (modes, basis_size, basis_time) = solve(op, mu, rebuilt)?;
+        let (modes, basis_size, basis_time) = solve(op, mu, op_changed)?;
         let mut pt = sweep_point(
             op,
             &modes,
@@ -284,7 +291,8 @@ pub fn run_mu_sweep(
             mu,
             eq.eq.active.iter().filter(|&&a| a).count(),
         );
-        pt.rebuilt = rebuilt;
+        pt.active_hash = crate::sweep::active_hash(&eq.eq.active);
+        pt.rebuilt = prev_hash != Some(pt.active_hash);
         pt.basis_size = basis_size;
         pt.times_s = [t_eq, t_op + basis_time, modes.info.time_s];
         if let Some(c) = checkpoint {

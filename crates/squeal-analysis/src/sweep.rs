@@ -23,6 +23,16 @@
 //! with, whose DvR mirrors it).
 
 use serde::{Deserialize, Serialize};
+
+/// FNV-1a fingerprint of an active-set mask.
+pub fn active_hash(active: &[bool]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &a in active {
+        h ^= u64::from(a);
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    h ^ (active.len() as u64)
+}
 use squeal_core::c64;
 
 /// One mode of a sweep point.
@@ -47,8 +57,13 @@ pub struct SweepPoint {
     pub mu: f64,
     /// Active contact pairs.
     pub active_pairs: usize,
-    /// Whether the operator (and the basis) was rebuilt at this point.
+    /// Whether the contact set differs from the previous sweep point's (a new operator and,
+    /// for bases fixed in mu, a new basis).
     pub rebuilt: bool,
+    /// Fingerprint of the active set (FNV-1a of the mask), to recognise equal contact sets
+    /// across resumed runs and shards.
+    #[serde(default)]
+    pub active_hash: u64,
     /// Basis size (0 for full order).
     pub basis_size: usize,
     /// Wall times (s): equilibrium, operator + basis, eigen solve.
@@ -292,6 +307,7 @@ mod tests {
             mu,
             active_pairs: 1,
             rebuilt: false,
+            active_hash: 0,
             basis_size: 0,
             times_s: [0.0; 3],
             modes,
