@@ -28,14 +28,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-/// The coarse build of the default scene used by `tests/stability.rs` (1560 DOFs).
+/// The embedded coarse rig (about 1600 DOFs).
 fn coarse() -> Scene {
-    let mut s = Scene::builtin("pin-on-disc").unwrap();
-    s.mesh.max_freq_hz = 1000.0;
-    s.mesh.pin_face_elements = 2;
-    s.mesh.min_layers = 1;
-    s.mesh.grading_ratio = 3.0;
-    s
+    Scene::builtin("pin-on-disc-coarse").unwrap()
 }
 
 fn params(fmax: f64) -> EigenParams {

@@ -6,13 +6,9 @@ use squeal::analysis::sweep::{Checkpoint, SweepPoint};
 use squeal::core::{EigenParams, Params};
 use squeal::scene::Scene;
 
+/// The embedded coarse rig (about 1600 DOFs).
 fn coarse() -> Scene {
-    let mut s = Scene::builtin("pin-on-disc").unwrap();
-    s.mesh.max_freq_hz = 1000.0;
-    s.mesh.pin_face_elements = 2;
-    s.mesh.min_layers = 1;
-    s.mesh.grading_ratio = 3.0;
-    s
+    Scene::builtin("pin-on-disc-coarse").unwrap()
 }
 
 /// Everything but the wall times.

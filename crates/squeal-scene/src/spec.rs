@@ -12,8 +12,11 @@ pub const PIN_ON_DISC: &str = include_str!("../../../scenes/pin-on-disc.toml");
 /// The same rig meshed at the paper's model size (about 300 000 DOFs).
 pub const PIN_ON_DISC_PAPER: &str = include_str!("../../../scenes/pin-on-disc-paper.toml");
 
+/// The same rig on a deliberately coarse mesh (about 1600 DOFs): tests and quick checks.
+pub const PIN_ON_DISC_COARSE: &str = include_str!("../../../scenes/pin-on-disc-coarse.toml");
+
 /// Names of the embedded scenes.
-pub const BUILTIN_SCENES: [&str; 2] = ["pin-on-disc", "pin-on-disc-paper"];
+pub const BUILTIN_SCENES: [&str; 3] = ["pin-on-disc", "pin-on-disc-paper", "pin-on-disc-coarse"];
 
 /// A material: plugin name plus its constants.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -402,12 +405,15 @@ impl Scene {
         Ok(scene)
     }
 
-    /// An embedded scene by name (`pin-on-disc`, `pin-on-disc-paper`).
+    /// An embedded scene by name (`pin-on-disc`, `pin-on-disc-paper`, `pin-on-disc-coarse`).
     pub fn builtin(name: &str) -> Result<Scene> {
         match name {
             "pin-on-disc" => Self::from_toml(PIN_ON_DISC, "<builtin pin-on-disc>"),
             "pin-on-disc-paper" => {
                 Self::from_toml(PIN_ON_DISC_PAPER, "<builtin pin-on-disc-paper>")
+            }
+            "pin-on-disc-coarse" => {
+                Self::from_toml(PIN_ON_DISC_COARSE, "<builtin pin-on-disc-coarse>")
             }
             other => Err(SceneError::Field {
                 file: format!("<builtin {other}>"),
