@@ -94,7 +94,11 @@ mod tests {
         p.0.insert("kn_n_per_m".into(), squeal_core::ParamValue::Num(5e8));
         let law = reg.contact_laws.create("penalty", &p).unwrap();
         assert_eq!(law.normal_stiffness(), Some(5e8));
-        let err = reg.contact_laws.create("lagrange", &p).err().expect("unknown key");
+        let err = reg
+            .contact_laws
+            .create("lagrange", &p)
+            .err()
+            .expect("unknown key");
         assert!(err.to_string().contains("kn_n_per_m"));
     }
 }
