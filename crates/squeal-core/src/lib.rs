@@ -9,7 +9,8 @@
 //! - [`Params`], the name/value parameters a plugin is built from;
 //! - the [`Registry`] that maps plugin names to constructors;
 //! - shared numerical machinery that every backend uses the same way ([`linalg`], [`qep`],
-//!   and [`reduction`] for the reduction bases).
+//!   [`lowrank`] for the Woodbury path of undamped frictional operators, and [`reduction`]
+//!   for the reduction bases).
 //!
 //! Units: SI throughout (m, kg, s, N, Pa); frequencies in Hz, eigenvalues of the
 //! symmetric problem `K x = omega^2 M x` in (rad/s)^2.
@@ -19,6 +20,7 @@ pub mod contact;
 pub mod eigen;
 pub mod error;
 pub mod linalg;
+pub mod lowrank;
 pub mod material;
 pub mod params;
 pub mod qep;
@@ -33,11 +35,12 @@ pub use eigen::{
     SymmetricKernel, SymmetricProblem,
 };
 pub use error::{Error, Result};
+pub use lowrank::{FrictionLowRank, QepLowRankSquared, SymmetricPencil, SymmetricShift};
 pub use material::{Material, Voigt6};
 pub use params::{ParamValue, Params};
 pub use qep::{
-    dense_qep, solve_qep_band, ComplexKernel, ComplexKernelOutput, ComplexLinOp, ComplexModes, Qep,
-    QepShiftInvert, QepSymbolic,
+    dense_qep, solve_frictional_band, solve_qep_band, ComplexKernel, ComplexKernelOutput,
+    ComplexLinOp, ComplexModes, LowRank, Qep, QepShiftInvert, QepSymbolic,
 };
 pub use reduction::{solve_reduced, ReducedOperator, ReducedSolve};
 pub use registry::Registry;

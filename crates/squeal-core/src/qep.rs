@@ -11,6 +11,8 @@
 //! shift-invert operator on the companion form ([`QepShiftInvert`]), the band driver
 //! ([`solve_qep_band`]), the dense solver for small and reduced problems ([`dense_qep`]) and
 //! the backward error ([`backward_error`]) are written once, here.
+//! Undamped frictional operators may instead go through the low-rank (Woodbury) path of
+//! [`crate::lowrank`] ([`solve_frictional_band`], [`QepBandOptions::low_rank`]).
 //!
 //! Backward error of a pair on the operator it was computed for:
 //! `eta = ||Q(lambda) u|| / ((|lambda|^2 ||M~|| + |lambda| ||C~|| + ||K~||) ||u||)`
@@ -19,12 +21,14 @@
 use crate::contact::FrictionalOperator;
 use crate::eigen::{validate_params, EigenParams, SolveInfo, StopReason};
 use crate::linalg::{check_square_finite, norm1};
+use crate::lowrank::{FrictionLowRank, QepLowRankSquared, SymmetricPencil, SymmetricShift};
 use crate::{c64, Error, Result, SparseMat, SparseRef};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, Triplet};
 use faer::{Mat, MatMut};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 #[cfg(test)]
@@ -518,6 +522,7 @@ impl ComplexLinOp for QepSquaredShift<'_> {
 enum WindowOp<'a> {
     Companion(QepShiftInvert<'a>),
     Squared(QepSquaredShift<'a>),
+    LowRank(QepLowRankSquared<'a>),
 }
 
 impl WindowOp<'_> {
@@ -525,6 +530,7 @@ impl WindowOp<'_> {
         match self {
             WindowOp::Companion(o) => o,
             WindowOp::Squared(o) => o,
+            WindowOp::LowRank(o) => o,
         }
     }
     /// (point in the plane of the window, lambda).
@@ -535,12 +541,14 @@ impl WindowOp<'_> {
                 (l, l)
             }
             WindowOp::Squared(o) => o.lambda_of_theta(theta),
+            WindowOp::LowRank(o) => o.lambda_of_theta(theta),
         }
     }
     fn applications(&self) -> usize {
         match self {
             WindowOp::Companion(o) => o.applications(),
             WindowOp::Squared(o) => o.applications(),
+            WindowOp::LowRank(o) => o.applications(),
         }
     }
 }
@@ -562,7 +570,30 @@ pub struct QepBandOptions {
     pub nev_default: usize,
     /// Use the real squared transformation ([`QepSquaredShift`]) when `C = 0`.
     pub squared_when_undamped: bool,
+    /// Whether the squared transformation of an undamped frictional operator goes through
+    /// the low-rank (Woodbury) path ([`QepLowRankSquared`]) instead of a sparse LU of
+    /// `K~ - s M~`. Only [`solve_frictional_band_with`] can use it (it needs the parts of
+    /// the operator); [`solve_qep_band_with`] ignores it.
+    pub low_rank: LowRank,
 }
+
+/// Choice of the low-rank (Woodbury) path of the band driver, see
+/// [`QepBandOptions::low_rank`] and [`crate::lowrank`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LowRank {
+    /// Use it when it applies (`C = 0`, squared transformation on, `friction_loads`
+    /// known and recoverable) and `n > LOW_RANK_AUTO_MIN_DIM`; otherwise, or when building
+    /// it fails, fall back to the sparse LU (noted in `info`).
+    #[default]
+    Auto,
+    /// Use it whenever the problem is solved iteratively; an error when it does not apply.
+    Always,
+    /// Never use it (sparse LU of `K~ - s M~`).
+    Never,
+}
+
+/// Size above which [`LowRank::Auto`] takes the low-rank path.
+pub const LOW_RANK_AUTO_MIN_DIM: usize = 20_000;
 
 impl Default for QepBandOptions {
     fn default() -> Self {
@@ -573,6 +604,7 @@ impl Default for QepBandOptions {
             max_depth: 10,
             nev_default: 24,
             squared_when_undamped: true,
+            low_rank: LowRank::Auto,
         }
     }
 }
@@ -622,7 +654,131 @@ pub fn solve_qep_band_with(
     options: &QepBandOptions,
     symbolic: Option<&QepSymbolic>,
 ) -> Result<ComplexModes> {
+    band_solve(
+        solver,
+        kernel,
+        qep,
+        params,
+        options,
+        symbolic,
+        LowRankChoice::Off,
+        Instant::now(),
+    )
+}
+
+/// Band driver on a frictional operator at `mu`: [`solve_frictional_band_with`] with
+/// default [`QepBandOptions`].
+pub fn solve_frictional_band(
+    solver: &str,
+    kernel: &dyn ComplexKernel,
+    op: &FrictionalOperator,
+    mu: f64,
+    params: &EigenParams,
+) -> Result<ComplexModes> {
+    solve_frictional_band_with(solver, kernel, op, mu, params, &QepBandOptions::default())
+}
+
+/// Band driver on a frictional operator at `mu`: the same as
+/// [`solve_qep_band_with`] on [`op.at(mu)`](FrictionalOperator::at), except that an
+/// undamped operator (`C = 0`, squared transformation) may go through the low-rank path
+/// ([`crate::lowrank`]: one symmetric `L B L^T` of `K_c - s M_c` per window and a
+/// Woodbury correction of rank `nA`) instead of a sparse LU of `K~ - s M~`, as
+/// [`QepBandOptions::low_rank`] says. The notes of the result say which path was taken,
+/// the number of stored entries of the factor, the rank and the measured accuracy.
+pub fn solve_frictional_band_with(
+    solver: &str,
+    kernel: &dyn ComplexKernel,
+    op: &FrictionalOperator,
+    mu: f64,
+    params: &EigenParams,
+    options: &QepBandOptions,
+) -> Result<ComplexModes> {
     let start = Instant::now();
+    let qep = op.at(mu)?;
+    let n = qep.dim();
+    let wanted = match options.low_rank {
+        LowRank::Never => false,
+        LowRank::Always => true,
+        LowRank::Auto => n > LOW_RANK_AUTO_MIN_DIM,
+    };
+    let iterative = 2 * n > params.dense_below;
+    let choice = if !wanted || !iterative {
+        LowRankChoice::Off
+    } else {
+        let why_not = if !options.squared_when_undamped {
+            Some("the squared transformation is off".to_string())
+        } else if qep.c.is_some() {
+            Some("the operator is damped (C != 0)".to_string())
+        } else if op.friction_loads.is_none() {
+            Some("the operator has no friction_loads".to_string())
+        } else {
+            None
+        };
+        let built = match why_not {
+            Some(w) => Err(Error::Invalid(w)),
+            None => FrictionLowRank::new(op).and_then(|fr| {
+                let t = Instant::now();
+                let pencil = SymmetricPencil::new(op)?;
+                if pencil.asymmetry() > crate::lowrank::MAX_ASYMMETRY {
+                    return Err(Error::Invalid(format!(
+                        "K_c / M_c are not symmetric (relative asymmetry {:.2e})",
+                        pencil.asymmetry()
+                    )));
+                }
+                Ok((fr, pencil, t.elapsed().as_secs_f64()))
+            }),
+        };
+        match built {
+            Ok((friction, pencil, t_sym)) => LowRankChoice::On(Box::new(LowRankCtx {
+                op,
+                mu,
+                friction,
+                pencil: Arc::new(pencil),
+                t_symbolic: t_sym,
+            })),
+            Err(e) if options.low_rank == LowRank::Always => {
+                return Err(Error::Invalid(format!(
+                    "low-rank path requested (LowRank::Always) but not applicable: {e}"
+                )))
+            }
+            Err(e) => LowRankChoice::Declined(format!(
+                "low-rank path not applicable ({e}); sparse LU used"
+            )),
+        }
+    };
+    band_solve(solver, kernel, &qep, params, options, None, choice, start)
+}
+
+/// Data of the low-rank path of one band solve.
+struct LowRankCtx<'a> {
+    op: &'a FrictionalOperator,
+    mu: f64,
+    friction: FrictionLowRank,
+    pencil: Arc<SymmetricPencil>,
+    t_symbolic: f64,
+}
+
+/// Whether a band solve uses the low-rank path.
+enum LowRankChoice<'a> {
+    /// Not considered.
+    Off,
+    /// Considered and declined (the note says why).
+    Declined(String),
+    /// Used.
+    On(Box<LowRankCtx<'a>>),
+}
+
+/// The band driver proper (see [`solve_qep_band_with`]).
+fn band_solve(
+    solver: &str,
+    kernel: &dyn ComplexKernel,
+    qep: &Qep,
+    params: &EigenParams,
+    options: &QepBandOptions,
+    symbolic: Option<&QepSymbolic>,
+    low_rank: LowRankChoice<'_>,
+    start: Instant,
+) -> Result<ComplexModes> {
     validate_params(params)?;
     check_qep(qep)?;
     let n = qep.dim();
@@ -663,13 +819,13 @@ pub fn solve_qep_band_with(
         modes.info.time_s = start.elapsed().as_secs_f64();
         return Ok(modes);
     }
-    let owned;
-    let sym = match symbolic {
-        Some(s) => s,
-        None => {
-            owned = QepSymbolic::new(qep)?;
-            &owned
+    let low_rank = match low_rank {
+        LowRankChoice::On(ctx) => Some(*ctx),
+        LowRankChoice::Declined(note) => {
+            info.notes.push(note);
+            None
         }
+        LowRankChoice::Off => None,
     };
     let cap = options.max_nev.min(n.saturating_sub(2)).max(1);
     let mut run = BandRun {
@@ -677,7 +833,9 @@ pub fn solve_qep_band_with(
         qep,
         params,
         options,
-        sym,
+        sym: symbolic,
+        sym_owned: None,
+        low_rank,
         cap,
         norms: QepNorms::of(qep),
         info,
@@ -703,7 +861,11 @@ struct BandRun<'a> {
     qep: &'a Qep,
     params: &'a EigenParams,
     options: &'a QepBandOptions,
-    sym: &'a QepSymbolic,
+    /// Symbolic LU analysis given by the caller (companion path only).
+    sym: Option<&'a QepSymbolic>,
+    /// Symbolic LU analysis built on first use by the companion path.
+    sym_owned: Option<QepSymbolic>,
+    low_rank: Option<LowRankCtx<'a>>,
     cap: usize,
     norms: QepNorms,
     info: SolveInfo,
@@ -711,44 +873,89 @@ struct BandRun<'a> {
     vectors: Vec<Vec<c64>>,
 }
 
-impl BandRun<'_> {
+impl<'a> BandRun<'a> {
+    /// The symbolic analysis of the companion path (built on first use).
+    fn symbolic(&mut self) -> Result<&QepSymbolic> {
+        if let Some(s) = self.sym {
+            return Ok(s);
+        }
+        if self.sym_owned.is_none() {
+            self.sym_owned = Some(QepSymbolic::new(self.qep)?);
+        }
+        Ok(self.sym_owned.as_ref().expect("built above"))
+    }
+
+    /// The operator of a squared window at `sigma_s`: low-rank when chosen, else LU.
+    fn squared_op(&mut self, sigma: f64, first: bool) -> Result<WindowOp<'a>> {
+        let qep: &'a Qep = self.qep;
+        let Some(ctx) = &self.low_rank else {
+            if first {
+                self.info.notes.push(
+                    "C = 0: real shift-invert of K - s M, s = -lambda^2 (squared \
+                     transformation), sparse LU of K~ - s M~"
+                        .into(),
+                );
+            }
+            return Ok(WindowOp::Squared(QepSquaredShift::new(qep, sigma)?));
+        };
+        let t = Instant::now();
+        let shift = SymmetricShift::new(ctx.op, ctx.pencil.clone(), &ctx.friction, sigma)?;
+        let t_factor = t.elapsed().as_secs_f64();
+        let op = QepLowRankSquared::new(qep, Arc::new(shift), ctx.mu)?;
+        if first {
+            self.info.notes.push(format!(
+                "C = 0: real shift-invert of K - s M, s = -lambda^2 (squared \
+                 transformation), low-rank path: symmetric LBL^T of K_c - s M_c \
+                 (nnz(L) = {} stored entries, symbolic {:.2} s, numeric + Z {:.2} s) + \
+                 Woodbury correction of rank nA = {} (U W^T error {:.1e}, asymmetry {:.1e}, \
+                 S residual {:.1e}, A residual {:.1e}{})",
+                ctx.pencil.factor_entries(),
+                ctx.t_symbolic,
+                t_factor,
+                ctx.friction.rank(),
+                ctx.friction.identity_error,
+                ctx.pencil.asymmetry(),
+                op.shift().s_residual(),
+                op.probe_residual(),
+                if op.refines() {
+                    ", one refinement step per solve"
+                } else {
+                    ""
+                }
+            ));
+        }
+        Ok(WindowOp::LowRank(op))
+    }
+
     /// Covers `[lo, hi]` Hz with one shift, or splits it.
     fn window(&mut self, lo: f64, hi: f64, depth: usize, nev0: usize) -> Result<()> {
         let n = self.qep.dim();
         let two_pi = 2.0 * std::f64::consts::PI;
         let squared = self.options.squared_when_undamped && self.qep.c.is_none();
+        let first = self.info.factorizations == 0;
         let (sigma, radius, op) = if squared {
             // the window in the plane of s = -lambda^2 = omega^2
             let (a, b) = ((two_pi * lo).powi(2), (two_pi * hi).powi(2));
             let sigma = 0.5 * (a + b);
             let radius = self.options.radius_factor * 0.5 * (b - a)
                 + self.options.margin_rel * (two_pi * hi).powi(2);
-            let op = QepSquaredShift::new(self.qep, sigma)?;
-            (c64::new(sigma, 0.0), radius, WindowOp::Squared(op))
+            let op = self.squared_op(sigma, first)?;
+            (c64::new(sigma, 0.0), radius, op)
         } else {
             let sigma = c64::new(0.0, two_pi * 0.5 * (lo + hi));
             let half = two_pi * 0.5 * (hi - lo);
-            let radius =
-                self.options.radius_factor * half + self.options.margin_rel * two_pi * hi;
-            let op = QepShiftInvert::with_symbolic(self.qep, sigma, self.sym)?;
+            let radius = self.options.radius_factor * half + self.options.margin_rel * two_pi * hi;
+            let qep: &'a Qep = self.qep;
+            let op = QepShiftInvert::with_symbolic(qep, sigma, self.symbolic()?)?;
             (sigma, radius, WindowOp::Companion(op))
         };
         let dim = op.linop().dim();
-        if squared && depth == 0 && self.info.factorizations == 0 {
-            self.info.notes.push(
-                "C = 0: real shift-invert of K - s M, s = -lambda^2 (squared transformation)"
-                    .into(),
-            );
-        }
         self.info.factorizations += 1;
         let mut nev = nev0.clamp(1, self.cap);
         let outcome = loop {
-            let out = self.kernel.largest(
-                op.linop(),
-                nev,
-                self.params.tol,
-                self.params.max_restarts,
-            )?;
+            let out =
+                self.kernel
+                    .largest(op.linop(), nev, self.params.tol, self.params.max_restarts)?;
             if out.vectors.nrows() != dim || out.vectors.ncols() < out.theta.len() {
                 return Err(Error::Dimension {
                     context: format!(

@@ -68,7 +68,8 @@ pub use kernel::ArpackKernel;
 use squeal_core::eigen::SymmetricKernel;
 use squeal_core::qep::ComplexKernel;
 use squeal_core::{
-    ComplexModes, EigenParams, EigenSolver, Params, Qep, RealModes, Result, SymmetricProblem,
+    ComplexModes, EigenParams, EigenSolver, FrictionalOperator, Params, Qep, RealModes, Result,
+    SymmetricProblem,
 };
 
 /// The registered name.
@@ -112,6 +113,17 @@ impl EigenSolver for ArpackSolver {
 
     fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {
         squeal_core::qep::solve_qep_band(NAME, &ArpackComplexKernel, qep, params)
+    }
+
+    /// The frictional operator through [`squeal_core::qep::solve_frictional_band`]: an
+    /// undamped operator may take the low-rank (symmetric factorization + Woodbury) path.
+    fn solve_frictional(
+        &self,
+        op: &FrictionalOperator,
+        mu: f64,
+        params: &EigenParams,
+    ) -> Result<ComplexModes> {
+        squeal_core::qep::solve_frictional_band(NAME, &ArpackComplexKernel, op, mu, params)
     }
 }
 

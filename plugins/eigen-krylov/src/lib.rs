@@ -117,8 +117,8 @@ use squeal_core::faer::linalg::matmul::matmul;
 use squeal_core::faer::{self, Accum, Mat, MatMut, MatRef, Par, Side};
 use squeal_core::linalg::{dot, ShiftInvert};
 use squeal_core::{
-    ComplexModes, EigenParams, EigenSolver, Error, Params, Qep, RealModes, Registry, Result,
-    SymmetricProblem,
+    ComplexModes, EigenParams, EigenSolver, Error, FrictionalOperator, Params, Qep, RealModes,
+    Registry, Result, SymmetricProblem,
 };
 
 pub mod schur;
@@ -179,6 +179,17 @@ impl EigenSolver for KrylovSolver {
     /// [`squeal_core::qep::solve_qep_band`] around [`KrylovSchurKernel`].
     fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {
         squeal_core::qep::solve_qep_band(NAME, &KrylovSchurKernel, qep, params)
+    }
+
+    /// The frictional operator through [`squeal_core::qep::solve_frictional_band`]: an
+    /// undamped operator may take the low-rank (symmetric factorization + Woodbury) path.
+    fn solve_frictional(
+        &self,
+        op: &FrictionalOperator,
+        mu: f64,
+        params: &EigenParams,
+    ) -> Result<ComplexModes> {
+        squeal_core::qep::solve_frictional_band(NAME, &KrylovSchurKernel, op, mu, params)
     }
 }
 
