@@ -1,6 +1,6 @@
 //! The unconstrained ("full") form of an operator on disk: `M.mtx`, `K.mtx`, optional
 //! `C.mtx` (free DOFs, symmetric) and `pairs.csv`, the contact data. Reading it builds
-//! the constrained operator with [`build_operator`](crate::build_operator), the same code
+//! the constrained operator with [`build_operator`], the same code
 //! path as a scene, so a model assembled elsewhere runs through every solver.
 //!
 //! `pairs.csv` columns (one row per candidate pair, DOF indices 0-based into the

@@ -2,7 +2,7 @@
 //! machinery every complex backend shares.
 //!
 //! `(lambda^2 M~ + lambda C~ + K~) u = 0` with `X~ = X_c - mu F_X` (see
-//! [`FrictionalOperator`](crate::contact::FrictionalOperator)). Convention
+//! [`FrictionalOperator`]). Convention
 //! `U = u exp(lambda t)`: a mode is unstable iff `Re(lambda) > 0`; its frequency is
 //! `Im(lambda) / 2 pi` and its divergence rate `DvR = Re(lambda) / Im(lambda)`. Results keep
 //! the `Im(lambda) > 0` member of each conjugate pair.
