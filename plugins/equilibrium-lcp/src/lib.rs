@@ -27,8 +27,12 @@ impl Default for LcpSolver {
     }
 }
 
-impl LcpSolver {
-    fn run(
+impl EquilibriumSolver for LcpSolver {
+    fn name(&self) -> &str {
+        "lcp"
+    }
+
+    fn solve_condensed(
         &self,
         cond: &Condensation,
         problem: &ContactProblem<'_>,
@@ -47,22 +51,6 @@ impl LcpSolver {
             sol.iterations,
             start.elapsed().as_secs_f64(),
         )
-    }
-}
-
-impl EquilibriumSolver for LcpSolver {
-    fn name(&self) -> &str {
-        "lcp"
-    }
-
-    fn solve_condensed(
-        &self,
-        cond: &Condensation,
-        problem: &ContactProblem<'_>,
-        law: &dyn ContactLaw,
-        mu: f64,
-    ) -> Result<Equilibrium> {
-        self.run(cond, problem, law, mu)
     }
 }
 

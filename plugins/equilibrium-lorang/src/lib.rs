@@ -35,8 +35,12 @@ impl Default for LorangSolver {
     }
 }
 
-impl LorangSolver {
-    fn run(
+impl EquilibriumSolver for LorangSolver {
+    fn name(&self) -> &str {
+        "lorang"
+    }
+
+    fn solve_condensed(
         &self,
         cond: &Condensation,
         problem: &ContactProblem<'_>,
@@ -47,9 +51,8 @@ impl LorangSolver {
         check_mu(mu)?;
         let nc = cond.pairs();
         let c = law.compliance();
-        let w = squeal_core::faer::Mat::from_fn(nc, nc, |i, j| {
-            cond.w[(i, j)] + if i == j { c } else { 0.0 }
-        });
+        // the symmetric part only: W + c I (friction enters as a known load)
+        let w = cond.lcp_matrix(0.0, c);
         let mut rn = vec![0.0; nc];
         let mut active: Vec<bool> = vec![false; nc];
         let mut change = f64::INFINITY;
@@ -93,22 +96,6 @@ impl LorangSolver {
                 active.iter().filter(|&&a| a).count()
             ),
         })
-    }
-}
-
-impl EquilibriumSolver for LorangSolver {
-    fn name(&self) -> &str {
-        "lorang"
-    }
-
-    fn solve_condensed(
-        &self,
-        cond: &Condensation,
-        problem: &ContactProblem<'_>,
-        law: &dyn ContactLaw,
-        mu: f64,
-    ) -> Result<Equilibrium> {
-        self.run(cond, problem, law, mu)
     }
 }
 
