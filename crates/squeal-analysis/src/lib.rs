@@ -5,6 +5,7 @@
 //! built scene ([`modal`]), automatic mode labels ([`labels`]) and the paper's reference
 //! values ([`reference`](mod@reference)).
 
+pub mod bench;
 pub mod labels;
 pub mod modal;
 pub mod pipeline;
