@@ -247,6 +247,11 @@ pub struct BenchRun {
     pub setup_s: f64,
     /// Eigen solve, expansion and backward errors (s).
     pub solve_s: f64,
+    /// Of `solve_s` for a reduced run: the reduced eigen solve alone (s).
+    pub reduced_solve_s: Option<f64>,
+    /// Of `solve_s` for a reduced run: expansion of the in-band modes and their backward
+    /// errors on the full operator (s).
+    pub expansion_s: Option<f64>,
     /// Peak heap above what was in use when the run started (MB), when measured.
     pub peak_mb: Option<f64>,
     /// Basis size (0 for full order).
@@ -410,6 +415,8 @@ pub fn bench_case(
         time_s: 0.0,
         setup_s: 0.0,
         solve_s: 0.0,
+        reduced_solve_s: None,
+        expansion_s: None,
         peak_mb: None,
         basis_size: 0,
         dofs: op.dim(),
@@ -510,6 +517,8 @@ pub fn bench_case(
                 }) {
                     Ok(r) => {
                         run.solve_s = t.elapsed().as_secs_f64();
+                        run.reduced_solve_s = Some(r.solve_time_s);
+                        run.expansion_s = Some(r.expansion_time_s);
                         run.errors = compare(&reference, &r.modes, opts.band_hz, opts.unstable_tol);
                     }
                     Err(e) => {

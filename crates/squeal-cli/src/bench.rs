@@ -161,9 +161,14 @@ fn print_run(r: &BenchRun) {
         );
         return;
     }
+    let split = match (r.reduced_solve_s, r.expansion_s) {
+        (Some(a), Some(b)) => format!(" (reduced {a:.2} + expansion {b:.2})"),
+        _ => String::new(),
+    };
     println!(
-        "  {:<26} n={:<6} setup {:>7.2} s  solve {:>7.2} s  df/f {:>8.1e}  dDvR {:>8.1e}  \
-         missed {}/{} false {}  bwd {:>8.1e}  x{:.1}{}",
+        "  {:<26} n={:<6} setup {:>7.2} s  solve {:>7.2} s{split}  df/f {:>8.1e}  \
+         dDvR {:>8.1e}  missed {} modes, {} unstable; false unstable {}  bwd {:>8.1e}  \
+         x{:.1}{}",
         format!("{}/{}{opts}", r.basis, r.eigen),
         if r.basis_size == 0 {
             r.dofs

@@ -22,6 +22,42 @@ pub fn add_scaled(a: SparseRef<'_>, alpha: f64, b: SparseRef<'_>, beta: f64) -> 
             got: b.nrows(),
         });
     }
+    let sorted = |m: SparseRef<'_>| {
+        (0..m.ncols()).all(|j| m.row_idx_of_col_raw(j).windows(2).all(|w| w[0] < w[1]))
+    };
+    if sorted(a) && sorted(b) {
+        // Column-by-column merge of sorted patterns: linear in nnz (the triplet path
+        // below sorts, about 10x slower on a 58k-DOF operator evaluated per mu).
+        let n = a.ncols();
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let cap = a.compute_nnz() + b.compute_nnz();
+        let (mut rows, mut vals) = (Vec::with_capacity(cap), Vec::with_capacity(cap));
+        col_ptr.push(0usize);
+        for j in 0..n {
+            let (ra, va) = (a.row_idx_of_col_raw(j), a.val_of_col(j));
+            let (rb, vb) = (b.row_idx_of_col_raw(j), b.val_of_col(j));
+            let (mut p, mut q) = (0, 0);
+            while p < ra.len() || q < rb.len() {
+                let (i, v) = if q == rb.len() || (p < ra.len() && ra[p] < rb[q]) {
+                    p += 1;
+                    (ra[p - 1], alpha * va[p - 1])
+                } else if p == ra.len() || rb[q] < ra[p] {
+                    q += 1;
+                    (rb[q - 1], beta * vb[q - 1])
+                } else {
+                    p += 1;
+                    q += 1;
+                    (ra[p - 1], alpha * va[p - 1] + beta * vb[q - 1])
+                };
+                rows.push(i);
+                vals.push(v);
+            }
+            col_ptr.push(rows.len());
+        }
+        let sym =
+            faer::sparse::SymbolicSparseColMat::new_checked(a.nrows(), n, col_ptr, None, rows);
+        return Ok(SparseMat::new(sym, vals));
+    }
     let mut trip = Vec::with_capacity(a.compute_nnz() + b.compute_nnz());
     for (m, s) in [(a, alpha), (b, beta)] {
         for j in 0..m.ncols() {
@@ -232,6 +268,44 @@ mod tests {
             .map(|(i, &x)| Triplet::new(i, i, x))
             .collect();
         SparseMat::try_new_from_triplets(v.len(), v.len(), &t).unwrap()
+    }
+
+    #[test]
+    fn add_scaled_merges_different_patterns_like_dense_addition() {
+        // Two 9 x 9 patterns that overlap partly, some columns empty in one of them.
+        let mut state = 7u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) as usize
+        };
+        let mut pattern = |density: usize| -> Vec<Triplet<usize, usize, f64>> {
+            (0..9)
+                .flat_map(|j| (0..9).map(move |i| (i, j)))
+                .filter(|_| next() % 10 < density)
+                .map(|(i, j)| Triplet::new(i, j, 1.0 + (i * 9 + j) as f64))
+                .collect()
+        };
+        let (ta, tb) = (pattern(4), pattern(3));
+        let a = SparseMat::try_new_from_triplets(9, 9, &ta).unwrap();
+        let b = SparseMat::try_new_from_triplets(9, 9, &tb).unwrap();
+        let c = add_scaled(a.as_ref(), 2.0, b.as_ref(), -0.5).unwrap();
+        let (da, db, dc) = (a.to_dense(), b.to_dense(), c.to_dense());
+        for i in 0..9 {
+            for j in 0..9 {
+                assert_eq!(
+                    dc[(i, j)],
+                    2.0 * da[(i, j)] - 0.5 * db[(i, j)],
+                    "({i}, {j})"
+                );
+            }
+        }
+        let union = (0..9)
+            .flat_map(|j| (0..9).map(move |i| (i, j)))
+            .filter(|&(i, j)| da[(i, j)] != 0.0 || db[(i, j)] != 0.0)
+            .count();
+        assert_eq!(c.compute_nnz(), union, "the pattern is the union of both");
     }
 
     #[test]

@@ -35,7 +35,7 @@
 use crate::contact::{Basis, BasisRequest, FrictionalOperator};
 use crate::eigen::{EigenParams, EigenSolver, RealModes, SymmetricProblem};
 use crate::linalg::{add_scaled, dot, spmv, Cholesky};
-use crate::qep::{finish_modes, spmv_complex, ComplexModes};
+use crate::qep::{finish_operator_modes, spmv_complex, ComplexModes};
 use crate::{c64, Error, Result, SparseMat, SparseRef};
 use faer::linalg::matmul::matmul;
 use faer::sparse::linalg::matmul::sparse_dense_matmul;
@@ -357,13 +357,20 @@ pub fn project(op: &FrictionalOperator, v: MatRef<'_, f64>) -> Result<Frictional
 
 /// Expands reduced vectors: `u = V q` (`V` real `n x m`, `q` complex `m x k`).
 pub fn expand(v: MatRef<'_, f64>, q: MatRef<'_, c64>) -> Mat<c64> {
-    let qr = Mat::from_fn(q.nrows(), q.ncols(), |i, j| q[(i, j)].re);
-    let qi = Mat::from_fn(q.nrows(), q.ncols(), |i, j| q[(i, j)].im);
-    let ur = v * &qr;
-    let ui = v * &qi;
-    Mat::from_fn(v.nrows(), q.ncols(), |i, j| {
-        c64::new(ur[(i, j)], ui[(i, j)])
-    })
+    // One real product V [Re Q, Im Q] (BLAS-3, parallel), then recombined.
+    let k = q.ncols();
+    let parts = Mat::from_fn(q.nrows(), 2 * k, |i, j| {
+        if j < k {
+            q[(i, j)].re
+        } else {
+            q[(i, j - k)].im
+        }
+    });
+    let mut u = Mat::<f64>::zeros(v.nrows(), 2 * k);
+    if k > 0 && v.ncols() > 0 {
+        matmul(u.as_mut(), Accum::Replace, v, parts.as_ref(), 1.0, par());
+    }
+    Mat::from_fn(v.nrows(), k, |i, j| c64::new(u[(i, j)], u[(i, j + k)]))
 }
 
 /// Complex modes of a reduced solve, expanded to the constrained space, with the cost of
@@ -440,8 +447,17 @@ impl ReducedOperator {
         let red = eigen.solve_frictional(&self.reduced, mu, params)?;
         let solve_time_s = start.elapsed().as_secs_f64();
         let start = Instant::now();
-        let u = expand(self.basis.v.as_ref(), red.vectors.as_ref());
-        let full = op.at(mu)?;
+        // Only the pairs `finish_modes` keeps are expanded: a dense reduced solve returns
+        // every root, and expanding them all would cost n x m x 2m.
+        let kept: Vec<usize> = crate::qep::band_pairs(&red.lambda, params)
+            .into_iter()
+            .map(|(_, i)| i)
+            .collect();
+        let q = Mat::from_fn(red.vectors.nrows(), kept.len(), |i, j| {
+            red.vectors[(i, kept[j])]
+        });
+        let lambda: Vec<c64> = kept.iter().map(|&i| red.lambda[i]).collect();
+        let u = expand(self.basis.v.as_ref(), q.as_ref());
         let mut info = red.info.clone();
         info.notes.push(format!(
             "reduced on a basis of {} vectors ({} dropped by the rank cut, {} iterations); \
@@ -451,7 +467,7 @@ impl ReducedOperator {
             self.basis.iterations
         ));
         info.notes.extend(self.basis.notes.iter().cloned());
-        let mut modes = finish_modes(&full, &red.lambda, u.as_ref(), params, info)?;
+        let mut modes = finish_operator_modes(op, mu, &lambda, u.as_ref(), params, info)?;
         let expansion_time_s = start.elapsed().as_secs_f64();
         modes.info.time_s = solve_time_s + expansion_time_s;
         Ok(ReducedSolve {

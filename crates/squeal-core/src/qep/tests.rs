@@ -626,6 +626,97 @@ fn finish_modes_normalizes_phase_and_sorts() {
     }
 }
 
+#[test]
+fn batched_backward_errors_equal_the_single_ones() {
+    for damped in [false, true] {
+        let qep = random_qep(7, 23, damped);
+        let (lam, u) = dense_qep(&qep).unwrap();
+        // Perturbed pairs, so the errors are far from round-off and comparable.
+        let lam: Vec<c64> = lam.iter().map(|l| *l * c(1.0 + 1e-3, 2e-4)).collect();
+        let mut rng = Rng(5);
+        let u = Mat::from_fn(7, lam.len(), |r, k| u[(r, k)] + c(1e-3 * rng.next(), 0.0));
+        let norms = QepNorms::of(&qep);
+        let batch = backward_errors(&QepTerms::of_qep(&qep), &norms, &lam, u.as_ref());
+        assert_eq!(batch.len(), lam.len());
+        for (j, l) in lam.iter().enumerate() {
+            let col: Vec<c64> = (0..7).map(|r| u[(r, j)]).collect();
+            let one = backward_error(&qep, *l, &col);
+            assert!(one > 1e-8, "the perturbation should show: {one:e}");
+            assert!(
+                (batch[j] - one).abs() <= 1e-12 * one,
+                "pair {j} (damped {damped}): batched {} vs single {one}",
+                batch[j]
+            );
+        }
+    }
+}
+
+#[test]
+fn operator_modes_are_checked_on_the_parts_like_the_assembled_operator() {
+    // A random operator whose friction parts overlap the symmetric ones partly.
+    let (a, b) = (random_qep(6, 3, true), random_qep(6, 4, true));
+    let lower = |m: &SparseMat, s: f64| {
+        let d = m.to_dense();
+        sparse(&Mat::from_fn(6, 6, |i, j| {
+            if i > j + 1 {
+                s * d[(i, j)]
+            } else {
+                0.0
+            }
+        }))
+    };
+    let op = FrictionalOperator {
+        mc: a.m.clone(),
+        cc: a.c.clone(),
+        kc: a.k.clone(),
+        fm: lower(&b.m, 0.3),
+        fc: Some(lower(b.c.as_ref().unwrap(), 0.5)),
+        fk: lower(&b.k, 2.0),
+        t: None,
+        friction_loads: None,
+    };
+    let params = EigenParams {
+        fmax_hz: 1e3,
+        ..Default::default()
+    };
+    let info = || SolveInfo {
+        solver: "t".into(),
+        time_s: 0.0,
+        requested: 0,
+        converged: 0,
+        iterations: 0,
+        op_applications: 0,
+        factorizations: 0,
+        reason: StopReason::Converged,
+        notes: vec![],
+    };
+    for mu in [0.0, 0.4, 1.3] {
+        let full = op.at(mu).unwrap();
+        let (lam, u) = dense_qep(&full).unwrap();
+        let lam: Vec<c64> = lam.iter().map(|l| *l * c(1.0, 1e-4)).collect();
+        let assembled = finish_modes(&full, &lam, u.as_ref(), &params, info()).unwrap();
+        let parts = finish_operator_modes(&op, mu, &lam, u.as_ref(), &params, info()).unwrap();
+        assert!(!assembled.is_empty());
+        assert_eq!(assembled.lambda, parts.lambda);
+        for (x, y) in assembled.backward_error.iter().zip(&parts.backward_error) {
+            assert!(*x > 1e-8, "the perturbation should show: {x:e}");
+            assert!(
+                (x - y).abs() <= 1e-12 * x,
+                "mu {mu}: assembled {x} vs parts {y}"
+            );
+        }
+    }
+    assert!(finish_operator_modes(
+        &op,
+        f64::NAN,
+        &[],
+        Mat::zeros(6, 0).as_ref(),
+        &params,
+        info()
+    )
+    .is_err());
+}
+
 /// Timing probe (run with `--ignored --nocapture`): dense_qep at companion sizes 500
 /// and 1000 on random damped pencils, with the worst backward error.
 #[test]

@@ -1,5 +1,6 @@
 use super::*;
 use crate::eigen::{dense_symmetric, finish_real_modes, SolveInfo, StopReason};
+use crate::qep::finish_modes;
 use crate::qep::{backward_error, dense_qep, Qep};
 
 /// Deterministic pseudo-random numbers in [-0.5, 0.5).
