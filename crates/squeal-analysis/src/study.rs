@@ -1,0 +1,1451 @@
+//! Long studies over contact zones: the paper's macroscopic effective zones (section 3.1,
+//! a rectangle `(x0, y0, a, b)` on the pin face) and mesoscopic plateau layouts (section
+//! 3.2, seeded random patches inside a fixed region).
+//!
+//! **Cases.** A study is a [`StudyDef`] (what to run: the zone grid or the plateau
+//! layouts, friction coefficients, methods, the model's contact grid) from which
+//! [`StudyDef::cases`] derives the case list, a pure function of the definition: each
+//! [`Case`] has a stable id built from its parameters (`mu03600-x004000-y002900-a012000-b014200`:
+//! mu to 1e-4, lengths in um; `mu03600-p000400-l00017` for patch 0.4 mm, layout 17), and
+//! the list is sorted by id. Zones that do not fit in the pin face, and zones or layouts
+//! that hold no contact pair, are skipped and counted.
+//!
+//! **Physics of a case.** Every pair of the zone is closed and sliding (no equilibrium
+//! solve): the contact set is built on the zone directly and the frictional operator on
+//! all its pairs, on a model built once for the whole study; the modes come from a
+//! [`Method`] (a reduction basis and an eigen solver, or full order).
+//!
+//! **Records.** Each finished case is appended at once to `results.jsonl` (one
+//! [`Record`] a line) and its wall times to `timings.jsonl` (one [`Timing`] a line): a
+//! killed run loses nothing, and a resumed run skips the ids already there. Records hold no
+//! times, so `results.jsonl` (rewritten sorted by id when a run ends) and `summary.json`
+//! are pure functions of the definition: a resumed run, a run with any number of jobs, or
+//! shards merged by [`merge`] give them byte for byte. Times live in `timings.jsonl` and
+//! `timings.json`.
+
+use crate::jsonl;
+use crate::pipeline::{Method, PipelineError};
+use serde::{Deserialize, Serialize};
+use squeal_contact::{build_operator, face_points, ContactSet};
+use squeal_core::{EigenParams, Params, Registry};
+use squeal_scene::{Model, Zone};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Instant;
+use thiserror::Error;
+
+/// Errors of studies; each names the option, file or case concerned.
+#[derive(Debug, Error)]
+pub enum StudyError {
+    /// A bad input, named by its command-line option.
+    #[error("{option}: {message}")]
+    Input {
+        /// The option, e.g. `--shard`.
+        option: String,
+        /// What is wrong and what is expected.
+        message: String,
+    },
+    /// A study directory that cannot be used.
+    #[error("{}: {message}", .path.display())]
+    Files {
+        /// The file or directory.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The model or a method.
+    #[error(transparent)]
+    Pipeline(#[from] PipelineError),
+}
+
+/// Result with [`StudyError`].
+pub type Result<T> = std::result::Result<T, StudyError>;
+
+fn input(option: &str, message: impl Into<String>) -> StudyError {
+    StudyError::Input {
+        option: option.into(),
+        message: message.into(),
+    }
+}
+
+fn files(path: &Path, message: impl std::fmt::Display) -> StudyError {
+    StudyError::Files {
+        path: path.to_path_buf(),
+        message: message.to_string(),
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Inputs.
+
+/// Parses a list of numbers: comma-separated values and inclusive ranges
+/// `FROM:TO:STEP` (e.g. `0.004:0.02:0.002,0.025`), in the given order; `option` names the
+/// option in errors.
+pub fn parse_list(option: &str, text: &str) -> Result<Vec<f64>> {
+    let num = |s: &str| -> Result<f64> {
+        let v = s
+            .trim()
+            .parse::<f64>()
+            .map_err(|_| input(option, format!("`{s}` in `{text}` is not a number")))?;
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(input(option, format!("`{s}` in `{text}` is not finite")))
+        }
+    };
+    let mut out = Vec::new();
+    for item in text.split(',').map(str::trim) {
+        if item.is_empty() {
+            return Err(input(
+                option,
+                format!("empty item in `{text}`: expected values or FROM:TO:STEP ranges, comma separated"),
+            ));
+        }
+        let parts: Vec<&str> = item.split(':').collect();
+        match parts.as_slice() {
+            [v] => out.push(num(v)?),
+            [a, b, c] => {
+                let (a, b, c) = (num(a)?, num(b)?, num(c)?);
+                if !(c > 0.0 && b >= a) {
+                    return Err(input(
+                        option,
+                        format!("range `{item}`: expected FROM:TO:STEP with FROM <= TO and STEP > 0"),
+                    ));
+                }
+                let n = ((b - a) / c + 1e-9).floor() as usize;
+                if n > 100_000 {
+                    return Err(input(option, format!("range `{item}` has {} values (at most 100001)", n + 1)));
+                }
+                out.extend((0..=n).map(|k| ((a + k as f64 * c) * 1e12).round() / 1e12));
+            }
+            _ => {
+                return Err(input(
+                    option,
+                    format!("`{item}`: expected a value or FROM:TO:STEP"),
+                ))
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Where zones start along one axis: centred on the pin face, or at given offsets from
+/// the face corner (m).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Axis {
+    /// The zone's centre on the face centre: `x0 = (size - a) / 2`.
+    Centred,
+    /// Offsets from the face corner (m).
+    Values(Vec<f64>),
+}
+
+impl Axis {
+    /// `centred` (or `centered`, `center`) or a list as in [`parse_list`], offsets >= 0.
+    pub fn parse(option: &str, text: &str) -> Result<Self> {
+        if matches!(text.trim(), "centred" | "centered" | "center" | "centre") {
+            return Ok(Axis::Centred);
+        }
+        let v = parse_list(option, text)?;
+        if let Some(x) = v.iter().find(|x| **x < 0.0) {
+            return Err(input(
+                option,
+                format!("expected offsets >= 0 m from the pin face corner (or `centred`), got {x}"),
+            ));
+        }
+        Ok(Axis::Values(v))
+    }
+
+    fn offsets(&self, size: f64, len: f64) -> Vec<f64> {
+        match self {
+            Axis::Centred => vec![((size - len) / 2.0 * 1e12).round() / 1e12],
+            Axis::Values(v) => v.clone(),
+        }
+    }
+}
+
+/// Part `K` of `N` of a study: the cases whose index (in id order) is `K - 1` modulo `N`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    /// 1-based part.
+    pub k: usize,
+    /// Number of parts.
+    pub n: usize,
+}
+
+impl Shard {
+    /// Parses `K/N` with `1 <= K <= N`.
+    pub fn parse(text: &str) -> Result<Self> {
+        let bad = || {
+            input(
+                "--shard",
+                format!("`{text}`: expected K/N with 1 <= K <= N (e.g. 2/8: the second of 8 parts)"),
+            )
+        };
+        let (k, n) = text.split_once('/').ok_or_else(bad)?;
+        let (k, n) = (
+            k.trim().parse::<usize>().map_err(|_| bad())?,
+            n.trim().parse::<usize>().map_err(|_| bad())?,
+        );
+        if k == 0 || n == 0 || k > n {
+            return Err(bad());
+        }
+        Ok(Self { k, n })
+    }
+
+    /// Whether case `index` belongs to this shard.
+    pub fn holds(&self, index: usize) -> bool {
+        index % self.n == self.k - 1
+    }
+}
+
+/// Parses a region `x0,y0,a,b` (m from the pin face corner).
+pub fn parse_region(option: &str, text: &str) -> Result<[f64; 4]> {
+    let v = parse_list(option, text)?;
+    match v.as_slice() {
+        [x0, y0, a, b] if *x0 >= 0.0 && *y0 >= 0.0 && *a > 0.0 && *b > 0.0 => Ok([*x0, *y0, *a, *b]),
+        _ => Err(input(
+            option,
+            format!("`{text}`: expected x0,y0,a,b in m (x0, y0 >= 0 from the pin face corner, a, b > 0)"),
+        )),
+    }
+}
+
+/// The macroscopic zone grid (paper section 3.1): every combination of the lists.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MacroSpec {
+    /// Friction coefficients.
+    pub mu: Vec<f64>,
+    /// Zone starts along x (sliding direction).
+    pub x0: Axis,
+    /// Zone starts along y (radius).
+    pub y0: Axis,
+    /// Zone lengths along x (m).
+    pub a_m: Vec<f64>,
+    /// Zone widths along y (m).
+    pub b_m: Vec<f64>,
+}
+
+/// The mesoscopic plateau layouts (paper section 3.2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MesoSpec {
+    /// Friction coefficients.
+    pub mu: Vec<f64>,
+    /// The macroscopic region cut into patches, `[x0, y0, a, b]` (m from the face corner).
+    pub region_m: [f64; 4],
+    /// Patch sides (m).
+    pub patch_m: Vec<f64>,
+    /// Layouts per patch size.
+    pub layouts: usize,
+    /// Fraction of the patches in contact, in (0, 1].
+    pub fraction: f64,
+    /// Base seed; layout `l` of patch size `p` uses [`derive_seed`]`(seed, p, l)`.
+    pub seed: u64,
+}
+
+/// What a study varies.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum StudySpec {
+    /// Macroscopic rectangles.
+    Macro(MacroSpec),
+    /// Mesoscopic plateaus.
+    Meso(MesoSpec),
+}
+
+/// How each case is solved.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SolveSpec {
+    /// Reduction basis plugin, or `none` for full order.
+    pub basis: String,
+    /// Basis parameters `key=value`.
+    pub basis_params: Vec<String>,
+    /// Eigen solver (of the reduced problem with a basis).
+    pub eigen: String,
+    /// Sparse symmetric solver of the basis's real modes.
+    pub modal: String,
+    /// Band (Hz).
+    pub band_hz: [f64; 2],
+    /// Relative tolerance of the eigen solvers.
+    pub tol: f64,
+    /// A mode is unstable when its DvR exceeds this.
+    pub dvr_tol: f64,
+    /// Frequencies (Hz) that classify unstable modes (nearest class).
+    pub classes_hz: Vec<f64>,
+}
+
+impl SolveSpec {
+    /// Checks the band, tolerances and classes, naming the options.
+    pub fn check(&self) -> Result<()> {
+        let [lo, hi] = self.band_hz;
+        if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo) {
+            return Err(input("--band", format!("expected 0 <= FMIN < FMAX (Hz), got {lo}:{hi}")));
+        }
+        if !(self.tol > 0.0 && self.tol < 1.0) {
+            return Err(input("--tol", format!("expected a tolerance in (0, 1), got {}", self.tol)));
+        }
+        if !(self.dvr_tol.is_finite() && self.dvr_tol >= 0.0) {
+            return Err(input("--dvr-tol", format!("expected a DvR threshold >= 0, got {}", self.dvr_tol)));
+        }
+        if self.classes_hz.is_empty() || self.classes_hz.iter().any(|c| !(*c > 0.0)) {
+            return Err(input("--classes", format!("expected frequencies > 0 Hz, got {:?}", self.classes_hz)));
+        }
+        Ok(())
+    }
+
+    /// The nearest class of a frequency.
+    pub fn class_of(&self, freq_hz: f64) -> f64 {
+        self.classes_hz
+            .iter()
+            .copied()
+            .min_by(|a, b| (a - freq_hz).abs().total_cmp(&(b - freq_hz).abs()))
+            .unwrap_or(0.0)
+    }
+
+    fn eigen_params(&self) -> EigenParams {
+        EigenParams {
+            fmin_hz: self.band_hz[0],
+            fmax_hz: self.band_hz[1],
+            tol: self.tol,
+            ..EigenParams::default()
+        }
+    }
+
+    /// A [`Method`] for one worker.
+    pub fn method(&self, registry: &Registry) -> Result<Method> {
+        let mut params = Params::new();
+        for kv in &self.basis_params {
+            let (k, v) = Params::parse_kv(kv)
+                .map_err(|e| input("--basis-opt", format!("`{kv}`: {e}")))?;
+            params.0.insert(k, v);
+        }
+        Ok(Method::new(
+            registry,
+            &self.basis,
+            &params,
+            &self.eigen,
+            &self.modal,
+            self.eigen_params(),
+        )?)
+    }
+}
+
+/// The contact grid of the model, in face coordinates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GridInfo {
+    /// Pin face size `[size_x, size_y]` (m).
+    pub face_m: [f64; 2],
+    /// Pairs along x and y.
+    pub n: [usize; 2],
+    /// Largest grid spacing along x and y (m).
+    pub spacing_m: [f64; 2],
+    /// Every pair (m from the face corner), in grid order.
+    pub points_m: Vec<[f64; 2]>,
+}
+
+impl GridInfo {
+    /// The contact grid of `model`.
+    pub fn of(model: &Model) -> Result<Self> {
+        let grid = model.contact.as_ref().ok_or_else(|| {
+            input(
+                "SCENE",
+                "the model has no contact pairs: a study needs a scene with a [disc] and a [pin]",
+            )
+        })?;
+        let (points_m, face_m) = face_points(grid);
+        let step = |v: &[f64]| v.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+        Ok(Self {
+            face_m,
+            n: [grid.xs.len(), grid.ys.len()],
+            spacing_m: [step(&grid.xs), step(&grid.ys)],
+            points_m,
+        })
+    }
+
+    /// Pairs of the grid inside `zone`.
+    pub fn pairs_in(&self, zone: &Zone) -> usize {
+        zone.select(&self.points_m, self.face_m)
+            .iter()
+            .filter(|&&b| b)
+            .count()
+    }
+}
+
+/// A whole study: written to `study.json`, equal in every shard of it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StudyDef {
+    /// squeal version that defined the study.
+    pub version: String,
+    /// Scene (file or embedded name).
+    pub scene: String,
+    /// Free DOFs of the model.
+    pub dofs: usize,
+    /// Rotation sense of the disc.
+    pub rotation: f64,
+    /// The contact grid.
+    pub grid: GridInfo,
+    /// What varies.
+    pub study: StudySpec,
+    /// How cases are solved.
+    pub solve: SolveSpec,
+}
+
+/// One case: a zone and a friction coefficient.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Case {
+    /// Stable id (see the module docs).
+    pub id: String,
+    /// Friction coefficient.
+    pub mu: f64,
+    /// The zone, every pair of which is closed and sliding.
+    pub zone: Zone,
+    /// Patch side asked for (m; plateaus only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub patch_m: Option<f64>,
+    /// Layout number within its patch size (plateaus only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layout: Option<usize>,
+    /// Contact pairs in the zone.
+    pub pairs: usize,
+    /// Nominal area of the zone (m^2): `a b`, or the patches' total area.
+    pub area_m2: f64,
+}
+
+/// Cases skipped when the case list was built.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Skipped {
+    /// Zones that do not fit in the pin face.
+    pub outside_face: usize,
+    /// Zones or layouts holding no contact pair.
+    pub no_pairs: usize,
+}
+
+/// The case list of a study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaseList {
+    /// Cases sorted by id.
+    pub cases: Vec<Case>,
+    /// What was skipped.
+    pub skipped: Skipped,
+    /// Layouts without pairs per patch size (meso; same order as `patch_m`).
+    pub no_pairs_by_patch: Vec<usize>,
+}
+
+/// The seed of layout `layout` of patch size number `patch` (splitmix64 of the three).
+pub fn derive_seed(base: u64, patch: usize, layout: usize) -> u64 {
+    let mix = |mut z: u64| {
+        z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    };
+    mix(mix(mix(base) ^ patch as u64) ^ layout as u64)
+}
+
+fn um(v: f64) -> i64 {
+    (v * 1e6).round() as i64
+}
+
+fn check_mu(mu: &[f64]) -> Result<()> {
+    if mu.is_empty() {
+        return Err(input("--mu", "expected at least one friction coefficient"));
+    }
+    if let Some(m) = mu.iter().find(|m| !(m.is_finite() && **m >= 0.0)) {
+        return Err(input(
+            "--mu",
+            format!("expected friction coefficients >= 0, got {m} (reverse the scene's study.rotation instead of a negative mu)"),
+        ));
+    }
+    Ok(())
+}
+
+fn positive(option: &str, v: &[f64], what: &str) -> Result<()> {
+    if v.is_empty() {
+        return Err(input(option, format!("expected at least one {what}")));
+    }
+    if let Some(x) = v.iter().find(|x| !(**x > 0.0)) {
+        return Err(input(option, format!("expected {what}s > 0 m, got {x}")));
+    }
+    Ok(())
+}
+
+impl StudyDef {
+    /// The case list (sorted by id), with the skipped zones counted. Errors name the
+    /// option when no case is left or an input is out of range.
+    pub fn cases(&self) -> Result<CaseList> {
+        let face = self.grid.face_m;
+        let tol = 1e-9 * (face[0] + face[1]);
+        let mut cases = Vec::new();
+        let mut skipped = Skipped::default();
+        let mut no_pairs_by_patch = Vec::new();
+        match &self.study {
+            StudySpec::Macro(s) => {
+                check_mu(&s.mu)?;
+                positive("--a", &s.a_m, "zone length")?;
+                positive("--b", &s.b_m, "zone width")?;
+                for &mu in &s.mu {
+                    for &a in &s.a_m {
+                        for &b in &s.b_m {
+                            for x0 in s.x0.offsets(face[0], a) {
+                                for y0 in s.y0.offsets(face[1], b) {
+                                    let fits = x0 >= -tol
+                                        && y0 >= -tol
+                                        && x0 + a <= face[0] + tol
+                                        && y0 + b <= face[1] + tol;
+                                    if !fits {
+                                        skipped.outside_face += 1;
+                                        continue;
+                                    }
+                                    let (x0, y0) = (x0.max(0.0), y0.max(0.0));
+                                    let zone = Zone::Rectangle {
+                                        x0_m: x0,
+                                        y0_m: y0,
+                                        a_m: a,
+                                        b_m: b,
+                                    };
+                                    let pairs = self.grid.pairs_in(&zone);
+                                    if pairs == 0 {
+                                        skipped.no_pairs += 1;
+                                        continue;
+                                    }
+                                    cases.push(Case {
+                                        id: format!(
+                                            "mu{:05}-x{:06}-y{:06}-a{:06}-b{:06}",
+                                            (mu * 1e4).round() as i64,
+                                            um(x0),
+                                            um(y0),
+                                            um(a),
+                                            um(b)
+                                        ),
+                                        mu,
+                                        zone,
+                                        patch_m: None,
+                                        layout: None,
+                                        pairs,
+                                        area_m2: a * b,
+                                    });
+                                }
+                            }
+                        }
+                    }
+                }
+                if cases.is_empty() {
+                    return Err(input(
+                        "--x0/--y0/--a/--b",
+                        format!(
+                            "no zone fits in the pin face ({} x {} mm) with a contact pair \
+                             ({} outside the face, {} without a pair): zones are [x0, x0 + a] x \
+                             [y0, y0 + b] in m from the face corner",
+                            face[0] * 1e3,
+                            face[1] * 1e3,
+                            skipped.outside_face,
+                            skipped.no_pairs
+                        ),
+                    ));
+                }
+            }
+            StudySpec::Meso(s) => {
+                check_mu(&s.mu)?;
+                let [x0, y0, a, b] = s.region_m;
+                if !(x0 >= 0.0
+                    && y0 >= 0.0
+                    && a > 0.0
+                    && b > 0.0
+                    && x0 + a <= face[0] + tol
+                    && y0 + b <= face[1] + tol)
+                {
+                    return Err(input(
+                        "--region",
+                        format!(
+                            "[{x0}, {y0}, {a}, {b}] must lie inside the pin face ({} x {} m) with a, b > 0",
+                            face[0], face[1]
+                        ),
+                    ));
+                }
+                positive("--patch", &s.patch_m, "patch side")?;
+                if let Some(p) = s.patch_m.iter().find(|p| **p > a.min(b) * (1.0 + 1e-9)) {
+                    return Err(input(
+                        "--patch",
+                        format!("patch side {p} m is larger than the region ({a} x {b} m)"),
+                    ));
+                }
+                if s.layouts == 0 {
+                    return Err(input("--layouts", "expected at least one layout per patch size"));
+                }
+                if !(s.fraction > 0.0 && s.fraction <= 1.0) {
+                    return Err(input(
+                        "--fraction",
+                        format!("expected a fraction of the patches in (0, 1], got {}", s.fraction),
+                    ));
+                }
+                for (pi, &patch) in s.patch_m.iter().enumerate() {
+                    let mut empty = 0;
+                    for l in 0..s.layouts {
+                        let zone = Zone::Plateaus {
+                            patch_m: patch,
+                            seed: derive_seed(s.seed, pi, l),
+                            fraction: Some(s.fraction),
+                            count: None,
+                            region_m: Some(s.region_m),
+                        };
+                        let pairs = self.grid.pairs_in(&zone);
+                        if pairs == 0 {
+                            empty += 1;
+                            continue;
+                        }
+                        let area_m2 = zone
+                            .plateau_rectangles(face)
+                            .unwrap_or_default()
+                            .iter()
+                            .map(|r| r[2] * r[3])
+                            .sum();
+                        for &mu in &s.mu {
+                            cases.push(Case {
+                                id: format!(
+                                    "mu{:05}-p{:06}-l{:05}",
+                                    (mu * 1e4).round() as i64,
+                                    um(patch),
+                                    l
+                                ),
+                                mu,
+                                zone: zone.clone(),
+                                patch_m: Some(patch),
+                                layout: Some(l),
+                                pairs,
+                                area_m2,
+                            });
+                        }
+                    }
+                    skipped.no_pairs += empty * s.mu.len();
+                    no_pairs_by_patch.push(empty);
+                }
+                if cases.is_empty() {
+                    return Err(input(
+                        "--patch",
+                        format!(
+                            "no layout holds a contact pair: the patches are smaller than the \
+                             contact grid spacing ({:.3} x {:.3} mm); raise mesh.pin_face_elements \
+                             in the scene or use larger patches",
+                            self.grid.spacing_m[0] * 1e3,
+                            self.grid.spacing_m[1] * 1e3
+                        ),
+                    ));
+                }
+            }
+        }
+        cases.sort_by(|a, b| a.id.cmp(&b.id));
+        if let Some(w) = cases.windows(2).find(|w| w[0].id == w[1].id) {
+            let option = match self.study {
+                StudySpec::Macro(_) => "--mu/--x0/--y0/--a/--b",
+                StudySpec::Meso(_) => "--mu/--patch",
+            };
+            return Err(input(
+                option,
+                format!(
+                    "two cases have the same id {} (duplicate values, or values closer than 1 um / 1e-4 in mu)",
+                    w[0].id
+                ),
+            ));
+        }
+        Ok(CaseList {
+            cases,
+            skipped,
+            no_pairs_by_patch,
+        })
+    }
+
+    /// Human-readable warnings (patches below the contact grid spacing, skipped cases).
+    pub fn warnings(&self, list: &CaseList) -> Vec<String> {
+        let mut w = Vec::new();
+        let sp = self.grid.spacing_m[0].max(self.grid.spacing_m[1]);
+        if let StudySpec::Meso(s) = &self.study {
+            for (i, &p) in s.patch_m.iter().enumerate() {
+                if p < sp * (1.0 - 1e-9) {
+                    w.push(format!(
+                        "patch {:.3} mm is smaller than the contact grid spacing {:.3} mm: a patch \
+                         holds at most one row/column of pairs and many hold none, so layouts \
+                         sample the grid rather than resolve plateaus (the paper used 0.2 mm \
+                         contact elements; raise mesh.pin_face_elements)",
+                        p * 1e3,
+                        sp * 1e3
+                    ));
+                }
+                if let Some(&n) = list.no_pairs_by_patch.get(i) {
+                    if n > 0 {
+                        w.push(format!(
+                            "patch {:.3} mm: {n} of {} layouts hold no contact pair and were skipped",
+                            p * 1e3,
+                            s.layouts
+                        ));
+                    }
+                }
+            }
+        }
+        if list.skipped.outside_face > 0 {
+            w.push(format!(
+                "{} zones do not fit in the pin face and were skipped",
+                list.skipped.outside_face
+            ));
+        }
+        if list.skipped.no_pairs > 0 && matches!(self.study, StudySpec::Macro(_)) {
+            w.push(format!(
+                "{} zones hold no contact pair and were skipped",
+                list.skipped.no_pairs
+            ));
+        }
+        w
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Records.
+
+/// An unstable mode of a case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct UnstableMode {
+    /// Frequency (Hz).
+    pub freq_hz: f64,
+    /// Divergence rate `Re / Im`.
+    pub dvr: f64,
+    /// Backward error on the full operator.
+    pub backward_error: f64,
+    /// The nearest class frequency (Hz).
+    pub class_hz: f64,
+}
+
+/// The result of one case: a line of `results.jsonl` (no times, see the module docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Record {
+    /// The case.
+    #[serde(flatten)]
+    pub case: Case,
+    /// Basis size (0 for full order).
+    pub basis_size: usize,
+    /// Unstable modes (DvR above the study's threshold), by frequency.
+    pub unstable: Vec<UnstableMode>,
+    /// Every mode in the band: `[freq_hz, dvr]`, by frequency.
+    pub modes: Vec<[f64; 2]>,
+    /// Largest backward error of the modes.
+    pub max_backward_error: f64,
+    /// Why the case failed (then no mode); failed cases are kept so a resume does not
+    /// retry them forever.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+/// Wall times of one case (s): a line of `timings.jsonl`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Timing {
+    /// Case id.
+    pub id: String,
+    /// Contact set of the zone.
+    pub contact_s: f64,
+    /// Frictional operator on all its pairs.
+    pub operator_s: f64,
+    /// Reduction basis build.
+    pub basis_s: f64,
+    /// Projection on the basis.
+    pub projection_s: f64,
+    /// Eigen solve (reduced with a basis).
+    pub solve_s: f64,
+    /// Expansion and backward errors on the full operator.
+    pub expansion_s: f64,
+    /// The whole case.
+    pub total_s: f64,
+}
+
+/// Solves one case on `model` with `method`.
+pub fn run_case(
+    model: &Model,
+    rotation: f64,
+    solve: &SolveSpec,
+    case: &Case,
+    method: &mut Method,
+) -> (Record, Timing) {
+    let start = Instant::now();
+    let mut t = Timing {
+        id: case.id.clone(),
+        ..Timing::default()
+    };
+    let mut rec = Record {
+        case: case.clone(),
+        basis_size: 0,
+        unstable: Vec::new(),
+        modes: Vec::new(),
+        max_backward_error: 0.0,
+        error: None,
+    };
+    let res = (|| -> std::result::Result<(), PipelineError> {
+        let t0 = Instant::now();
+        let set = ContactSet::new(model, &case.zone, rotation)?;
+        t.contact_s = t0.elapsed().as_secs_f64();
+        let t1 = Instant::now();
+        let op = build_operator(
+            model.m.as_ref(),
+            None,
+            model.k.as_ref(),
+            &set,
+            &vec![true; set.len()],
+        )?;
+        t.operator_s = t1.elapsed().as_secs_f64();
+        let (modes, basis_size, _) = method.solve(&op, case.mu, true)?;
+        let st = method.last_times();
+        (t.basis_s, t.projection_s, t.solve_s, t.expansion_s) =
+            (st.basis_s, st.projection_s, st.solve_s, st.expansion_s);
+        rec.basis_size = basis_size;
+        let mut idx: Vec<usize> = (0..modes.len()).collect();
+        idx.sort_by(|&a, &b| modes.freq_hz[a].total_cmp(&modes.freq_hz[b]));
+        for i in idx {
+            let (f, d, be) = (modes.freq_hz[i], modes.dvr[i], modes.backward_error[i]);
+            rec.modes.push([f, d]);
+            rec.max_backward_error = rec.max_backward_error.max(be);
+            if d > solve.dvr_tol {
+                rec.unstable.push(UnstableMode {
+                    freq_hz: f,
+                    dvr: d,
+                    backward_error: be,
+                    class_hz: solve.class_of(f),
+                });
+            }
+        }
+        Ok(())
+    })();
+    if let Err(e) = res {
+        rec.error = Some(format!("case {}: {e}", case.id));
+    }
+    t.total_s = start.elapsed().as_secs_f64();
+    (rec, t)
+}
+
+// ---------------------------------------------------------------------------------------
+// Running.
+
+/// The files of a study directory.
+pub struct StudyDir {
+    /// The directory.
+    pub dir: PathBuf,
+}
+
+impl StudyDir {
+    /// A study directory (not created yet).
+    pub fn new(dir: impl Into<PathBuf>) -> Self {
+        Self { dir: dir.into() }
+    }
+    /// `study.json`: the definition.
+    pub fn study(&self) -> PathBuf {
+        self.dir.join("study.json")
+    }
+    /// `results.jsonl`: one [`Record`] a line.
+    pub fn results(&self) -> PathBuf {
+        self.dir.join("results.jsonl")
+    }
+    /// `timings.jsonl`: one [`Timing`] a line.
+    pub fn timings(&self) -> PathBuf {
+        self.dir.join("timings.jsonl")
+    }
+    /// `summary.json`: the [`Summary`].
+    pub fn summary(&self) -> PathBuf {
+        self.dir.join("summary.json")
+    }
+    /// `timings.json`: the [`TimingSummary`].
+    pub fn timing_summary(&self) -> PathBuf {
+        self.dir.join("timings.json")
+    }
+
+    /// Reads `study.json`.
+    pub fn read_def(&self) -> Result<StudyDef> {
+        let p = self.study();
+        let text = std::fs::read_to_string(&p).map_err(|e| files(&p, format!("{e} (not a study directory?)")))?;
+        serde_json::from_str(&text).map_err(|e| files(&p, e))
+    }
+
+    /// Records of `results.jsonl` (a torn last line is ignored).
+    pub fn records(&self) -> Result<Vec<Record>> {
+        jsonl::load(&self.results()).map_err(|e| files(&self.results(), e))
+    }
+
+    /// Timings of `timings.jsonl`.
+    pub fn timing_records(&self) -> Result<Vec<Timing>> {
+        jsonl::load(&self.timings()).map_err(|e| files(&self.timings(), e))
+    }
+}
+
+/// How to run a study.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Parallel cases (each with its own [`Method`]); 0 or 1 runs them one after the other
+    /// on the calling thread (each case still uses every core through faer).
+    pub jobs: usize,
+    /// Only this part of the cases.
+    pub shard: Option<Shard>,
+    /// Continue a directory that already holds results (else that is an error).
+    pub resume: bool,
+    /// Stop after this many new cases (a batch slot; the rest is left for a resume).
+    pub max_cases: Option<usize>,
+}
+
+/// What a run did.
+#[derive(Debug, Clone)]
+pub struct RunReport {
+    /// Cases of the whole study.
+    pub cases: usize,
+    /// Cases of this run's shard.
+    pub shard_cases: usize,
+    /// Cases found already done.
+    pub resumed: usize,
+    /// Cases computed now.
+    pub computed: usize,
+    /// Shard cases still to do (after `max_cases`).
+    pub remaining: usize,
+    /// The summary written.
+    pub summary: Summary,
+    /// The timings summary written.
+    pub timings: TimingSummary,
+}
+
+fn first_difference(a: &serde_json::Value, b: &serde_json::Value) -> String {
+    match (a, b) {
+        (serde_json::Value::Object(x), serde_json::Value::Object(y)) => x
+            .iter()
+            .find(|(k, v)| y.get(*k) != Some(*v))
+            .map(|(k, v)| match y.get(k) {
+                Some(w) => format!("{k}: {}", first_difference(v, w)),
+                None => k.clone(),
+            })
+            .or_else(|| y.keys().find(|k| !x.contains_key(*k)).cloned())
+            .unwrap_or_default(),
+        _ => format!("{a} vs {b}"),
+    }
+}
+
+/// Writes `study.json`, or checks an existing one is the same study.
+fn claim(dir: &StudyDir, def: &StudyDef, resume: bool) -> Result<()> {
+    std::fs::create_dir_all(&dir.dir).map_err(|e| files(&dir.dir, e))?;
+    let has_results = std::fs::metadata(dir.results()).is_ok_and(|m| m.len() > 0);
+    if has_results && !resume {
+        return Err(input(
+            "--out",
+            format!(
+                "{} already holds results: pass --resume to continue that study, or choose another directory",
+                dir.dir.display()
+            ),
+        ));
+    }
+    let want = serde_json::to_value(def).map_err(|e| files(&dir.study(), e))?;
+    if dir.study().exists() {
+        let have = serde_json::to_value(dir.read_def()?).map_err(|e| files(&dir.study(), e))?;
+        if have != want {
+            return Err(files(
+                &dir.study(),
+                format!(
+                    "written for another study (differs at {}): use another --out",
+                    first_difference(&have, &want)
+                ),
+            ));
+        }
+        return Ok(());
+    }
+    let text = serde_json::to_string_pretty(&want).map_err(|e| files(&dir.study(), e))?;
+    jsonl::write_atomic(&dir.study(), text.as_bytes()).map_err(|e| files(&dir.study(), e))
+}
+
+/// Runs (or resumes) a study in `dir` on `model` (built from the definition's scene).
+/// Every finished case is appended at once; when the run ends, `results.jsonl` and
+/// `timings.jsonl` are rewritten sorted by id and `summary.json`, `timings.json` written
+/// from every record in the directory. `progress(done, total, record)` sees each new case.
+pub fn run(
+    registry: &Registry,
+    model: &Model,
+    def: &StudyDef,
+    dir: &StudyDir,
+    opts: &RunOptions,
+    progress: &(dyn Fn(usize, usize, &Record) + Sync),
+) -> Result<RunReport> {
+    def.solve.check()?;
+    if model.dofs.n_free() != def.dofs {
+        return Err(input(
+            "SCENE",
+            format!("the model has {} DOFs, the study {}", model.dofs.n_free(), def.dofs),
+        ));
+    }
+    let list = def.cases()?;
+    // fail fast on unknown plugins or parameters
+    drop(def.solve.method(registry)?);
+    claim(dir, def, opts.resume)?;
+    let done: std::collections::BTreeSet<String> =
+        dir.records()?.into_iter().map(|r| r.case.id).collect();
+    let shard: Vec<&Case> = list
+        .cases
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| opts.shard.is_none_or(|s| s.holds(*i)))
+        .map(|(_, c)| c)
+        .collect();
+    let resumed = shard.iter().filter(|c| done.contains(&c.id)).count();
+    let mut todo: Vec<&Case> = shard.iter().copied().filter(|c| !done.contains(&c.id)).collect();
+    let remaining_after = todo.len().saturating_sub(opts.max_cases.unwrap_or(usize::MAX));
+    todo.truncate(opts.max_cases.unwrap_or(usize::MAX));
+    let total = todo.len();
+    let lock = Mutex::new(0usize);
+    let io_error: Mutex<Option<StudyError>> = Mutex::new(None);
+    let finish = |rec: Record, t: Timing| -> bool {
+        let mut n = lock.lock().unwrap_or_else(|e| e.into_inner());
+        let res = jsonl::append(&dir.results(), &rec)
+            .map_err(|e| files(&dir.results(), e))
+            .and_then(|_| jsonl::append(&dir.timings(), &t).map_err(|e| files(&dir.timings(), e)));
+        if let Err(e) = res {
+            *io_error.lock().unwrap_or_else(|e| e.into_inner()) = Some(e);
+            return false;
+        }
+        *n += 1;
+        progress(*n, total, &rec);
+        true
+    };
+    let rotation = def.rotation;
+    if opts.jobs <= 1 {
+        let mut method = def.solve.method(registry)?;
+        for case in &todo {
+            let (rec, t) = run_case(model, rotation, &def.solve, case, &mut method);
+            if !finish(rec, t) {
+                break;
+            }
+        }
+    } else {
+        use rayon::prelude::*;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(opts.jobs)
+            .build()
+            .map_err(|e| input("--jobs", format!("cannot start {} workers: {e}", opts.jobs)))?;
+        pool.install(|| {
+            todo.par_iter().with_max_len(1).for_each_init(
+                || def.solve.method(registry),
+                |method, case| {
+                    if io_error.lock().map(|e| e.is_some()).unwrap_or(true) {
+                        return;
+                    }
+                    let (rec, t) = match method {
+                        Ok(m) => run_case(model, rotation, &def.solve, case, m),
+                        Err(e) => {
+                            *io_error.lock().unwrap_or_else(|e| e.into_inner()) =
+                                Some(input("--basis/--eigen", e.to_string()));
+                            return;
+                        }
+                    };
+                    finish(rec, t);
+                },
+            );
+        });
+    }
+    if let Some(e) = io_error.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        return Err(e);
+    }
+    let records = dir.records()?;
+    let timings = dir.timing_records()?;
+    let (summary, tsum) = finalize(dir, def, &list, records, timings)?;
+    Ok(RunReport {
+        cases: list.cases.len(),
+        shard_cases: shard.len(),
+        resumed,
+        computed: total,
+        remaining: remaining_after,
+        summary,
+        timings: tsum,
+    })
+}
+
+/// Joins shard directories of one study into `out`: the same `study.json`,
+/// `results.jsonl`, `timings.jsonl`, `summary.json` and `timings.json` as one run over the
+/// whole study. Errors if the shards are of different studies or disagree on a case.
+pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<(StudyDef, Summary, TimingSummary)> {
+    let Some(first) = inputs.first() else {
+        return Err(input("DIRS", "expected at least one study directory"));
+    };
+    let def = StudyDir::new(first).read_def()?;
+    let want = serde_json::to_value(&def).map_err(|e| files(first, e))?;
+    let mut records: std::collections::BTreeMap<String, Record> = Default::default();
+    let mut timings: std::collections::BTreeMap<String, Timing> = Default::default();
+    for d in inputs {
+        let sd = StudyDir::new(d);
+        let other = serde_json::to_value(sd.read_def()?).map_err(|e| files(d, e))?;
+        if other != want {
+            return Err(files(
+                &sd.study(),
+                format!(
+                    "another study than {} (differs at {})",
+                    StudyDir::new(first).study().display(),
+                    first_difference(&want, &other)
+                ),
+            ));
+        }
+        for r in sd.records()? {
+            if let Some(prev) = records.get(&r.case.id) {
+                if prev != &r {
+                    return Err(files(
+                        &sd.results(),
+                        format!("case {} differs from the one in another directory", r.case.id),
+                    ));
+                }
+            }
+            records.insert(r.case.id.clone(), r);
+        }
+        for t in sd.timing_records()? {
+            timings.insert(t.id.clone(), t);
+        }
+    }
+    let list = def.cases()?;
+    let od = StudyDir::new(out);
+    if od.dir.canonicalize().ok().is_some_and(|o| {
+        inputs
+            .iter()
+            .any(|i| i.canonicalize().ok().as_ref() == Some(&o))
+    }) {
+        return Err(input("--out", "the merged directory must not be one of the inputs"));
+    }
+    std::fs::create_dir_all(out).map_err(|e| files(out, e))?;
+    let text = serde_json::to_string_pretty(&want).map_err(|e| files(&od.study(), e))?;
+    jsonl::write_atomic(&od.study(), text.as_bytes()).map_err(|e| files(&od.study(), e))?;
+    let (s, t) = finalize(
+        &od,
+        &def,
+        &list,
+        records.into_values().collect(),
+        timings.into_values().collect(),
+    )?;
+    Ok((def, s, t))
+}
+
+/// Rewrites the records sorted by id (only those of the case list, one per id) and writes
+/// the summaries.
+fn finalize(
+    dir: &StudyDir,
+    def: &StudyDef,
+    list: &CaseList,
+    records: Vec<Record>,
+    timings: Vec<Timing>,
+) -> Result<(Summary, TimingSummary)> {
+    let ids: std::collections::BTreeSet<&str> = list.cases.iter().map(|c| c.id.as_str()).collect();
+    let mut by_id: std::collections::BTreeMap<String, Record> = Default::default();
+    for r in records.into_iter().filter(|r| ids.contains(r.case.id.as_str())) {
+        by_id.insert(r.case.id.clone(), r);
+    }
+    let records: Vec<Record> = by_id.into_values().collect();
+    let mut t_by_id: std::collections::BTreeMap<String, Timing> = Default::default();
+    for t in timings.into_iter().filter(|t| ids.contains(t.id.as_str())) {
+        t_by_id.insert(t.id.clone(), t);
+    }
+    let timings: Vec<Timing> = t_by_id.into_values().collect();
+    jsonl::write_all(&dir.results(), &records).map_err(|e| files(&dir.results(), e))?;
+    jsonl::write_all(&dir.timings(), &timings).map_err(|e| files(&dir.timings(), e))?;
+    let summary = summarize(def, list, &records);
+    let text = serde_json::to_string_pretty(&summary).map_err(|e| files(&dir.summary(), e))?;
+    jsonl::write_atomic(&dir.summary(), format!("{text}\n").as_bytes())
+        .map_err(|e| files(&dir.summary(), e))?;
+    let tsum = TimingSummary::of(&timings);
+    let text = serde_json::to_string_pretty(&tsum).map_err(|e| files(&dir.timing_summary(), e))?;
+    jsonl::write_atomic(&dir.timing_summary(), format!("{text}\n").as_bytes())
+        .map_err(|e| files(&dir.timing_summary(), e))?;
+    Ok((summary, tsum))
+}
+
+// ---------------------------------------------------------------------------------------
+// Summaries.
+
+/// Unstable cases of one class.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ClassSummary {
+    /// Class frequency (Hz).
+    pub class_hz: f64,
+    /// Cases with an unstable mode of this class.
+    pub cases: usize,
+    /// Smallest, mean and largest zone area of those cases (m^2).
+    pub area_m2: [f64; 3],
+    /// Frequency range of the class's unstable modes (Hz).
+    pub freq_hz: [f64; 2],
+    /// DvR range of the class's unstable modes.
+    pub dvr: [f64; 2],
+    /// The zones `[x0, y0, a, b]` (m) of those cases (macroscopic studies only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub zones_m: Vec<[f64; 4]>,
+}
+
+/// Results at one friction coefficient.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MuSummary {
+    /// Friction coefficient.
+    pub mu: f64,
+    /// Cases done.
+    pub cases: usize,
+    /// Cases with at least one unstable mode.
+    pub unstable: usize,
+    /// Unstable cases per class.
+    pub classes: Vec<ClassSummary>,
+}
+
+/// Results of one patch size (mesoscopic studies).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PatchSummary {
+    /// Friction coefficient.
+    pub mu: f64,
+    /// Patch side asked for (m).
+    pub patch_m: f64,
+    /// Patch sides actually cut (the region divided into whole patches) (m).
+    pub patch_side_m: [f64; 2],
+    /// Whether the patch is smaller than the contact grid spacing (see the warnings).
+    pub below_grid_spacing: bool,
+    /// Layouts asked for.
+    pub layouts: usize,
+    /// Layouts skipped (no contact pair under their patches).
+    pub skipped_no_pairs: usize,
+    /// Layouts done.
+    pub done: usize,
+    /// Unstable layouts.
+    pub unstable: usize,
+    /// `unstable / done`.
+    pub unstable_fraction: f64,
+    /// Smallest and largest pairs in contact over the layouts.
+    pub pairs: [usize; 2],
+    /// Unstable layouts per class.
+    pub classes: Vec<ClassSummary>,
+}
+
+/// `summary.json`: a pure function of the definition and the records.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// squeal version.
+    pub version: String,
+    /// `macro` or `meso`.
+    pub kind: String,
+    /// Units of the fields.
+    pub units: String,
+    /// Scene.
+    pub scene: String,
+    /// Free DOFs of the model.
+    pub dofs: usize,
+    /// Methods and thresholds.
+    pub methods: SolveSpec,
+    /// What varies.
+    pub params: StudySpec,
+    /// The contact grid: pairs along x and y, spacing and face size (m).
+    pub contact_grid: GridSummary,
+    /// Cases of the study.
+    pub cases: usize,
+    /// Cases with a record.
+    pub cases_done: usize,
+    /// Whether every case has a record (false in a shard or a stopped run).
+    pub complete: bool,
+    /// Cases skipped when the list was built.
+    pub skipped: Skipped,
+    /// Cases whose solve failed (their records carry the error).
+    pub failed: usize,
+    /// Cases with at least one unstable mode.
+    pub unstable_cases: usize,
+    /// Overall unstable fraction of the cases done.
+    pub unstable_fraction: f64,
+    /// Largest backward error over every mode.
+    pub max_backward_error: f64,
+    /// Per friction coefficient.
+    pub by_mu: Vec<MuSummary>,
+    /// Per patch size and friction coefficient (mesoscopic studies).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub by_patch: Vec<PatchSummary>,
+    /// Warnings (patches below the grid spacing, skipped cases).
+    pub warnings: Vec<String>,
+    /// Where the wall times are.
+    pub timings: String,
+}
+
+/// The contact grid in a summary.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GridSummary {
+    /// Pairs along x and y.
+    pub pairs: [usize; 2],
+    /// Largest spacing along x and y (m).
+    pub spacing_m: [f64; 2],
+    /// Pin face size (m).
+    pub face_m: [f64; 2],
+}
+
+fn class_summaries(solve: &SolveSpec, records: &[&Record], with_zones: bool) -> Vec<ClassSummary> {
+    solve
+        .classes_hz
+        .iter()
+        .map(|&c| {
+            let of: Vec<&Record> = records
+                .iter()
+                .copied()
+                .filter(|r| r.unstable.iter().any(|m| m.class_hz == c))
+                .collect();
+            let modes: Vec<&UnstableMode> = of
+                .iter()
+                .flat_map(|r| r.unstable.iter().filter(|m| m.class_hz == c))
+                .collect();
+            let range = |v: &mut dyn Iterator<Item = f64>| -> [f64; 2] {
+                v.fold([f64::INFINITY, f64::NEG_INFINITY], |a, x| [a[0].min(x), a[1].max(x)])
+            };
+            let fix = |r: [f64; 2]| if r[0].is_finite() { r } else { [0.0, 0.0] };
+            let areas: Vec<f64> = of.iter().map(|r| r.case.area_m2).collect();
+            let ar = fix(range(&mut areas.iter().copied()));
+            let mean = if areas.is_empty() {
+                0.0
+            } else {
+                areas.iter().sum::<f64>() / areas.len() as f64
+            };
+            ClassSummary {
+                class_hz: c,
+                cases: of.len(),
+                area_m2: [ar[0], mean, ar[1]],
+                freq_hz: fix(range(&mut modes.iter().map(|m| m.freq_hz))),
+                dvr: fix(range(&mut modes.iter().map(|m| m.dvr))),
+                zones_m: if with_zones {
+                    of.iter()
+                        .filter_map(|r| match r.case.zone {
+                            Zone::Rectangle {
+                                x0_m,
+                                y0_m,
+                                a_m,
+                                b_m,
+                            } => Some([x0_m, y0_m, a_m, b_m]),
+                            _ => None,
+                        })
+                        .collect()
+                } else {
+                    Vec::new()
+                },
+            }
+        })
+        .collect()
+}
+
+/// The summary of `records` (sorted by id, those of `list`).
+pub fn summarize(def: &StudyDef, list: &CaseList, records: &[Record]) -> Summary {
+    let is_macro = matches!(def.study, StudySpec::Macro(_));
+    let mus: Vec<f64> = match &def.study {
+        StudySpec::Macro(s) => s.mu.clone(),
+        StudySpec::Meso(s) => s.mu.clone(),
+    };
+    let unstable = |r: &Record| !r.unstable.is_empty();
+    let by_mu = mus
+        .iter()
+        .map(|&mu| {
+            let rs: Vec<&Record> = records.iter().filter(|r| r.case.mu == mu).collect();
+            MuSummary {
+                mu,
+                cases: rs.len(),
+                unstable: rs.iter().filter(|r| unstable(r)).count(),
+                classes: class_summaries(&def.solve, &rs, is_macro),
+            }
+        })
+        .collect();
+    let mut by_patch = Vec::new();
+    if let StudySpec::Meso(s) = &def.study {
+        let sp = def.grid.spacing_m[0].max(def.grid.spacing_m[1]);
+        let [_, _, a, b] = s.region_m;
+        for &mu in &s.mu {
+            for (pi, &p) in s.patch_m.iter().enumerate() {
+                let rs: Vec<&Record> = records
+                    .iter()
+                    .filter(|r| r.case.mu == mu && r.case.patch_m == Some(p))
+                    .collect();
+                let nx = ((a / p).round() as usize).max(1);
+                let ny = ((b / p).round() as usize).max(1);
+                let u = rs.iter().filter(|r| unstable(r)).count();
+                by_patch.push(PatchSummary {
+                    mu,
+                    patch_m: p,
+                    patch_side_m: [a / nx as f64, b / ny as f64],
+                    below_grid_spacing: p < sp * (1.0 - 1e-9),
+                    layouts: s.layouts,
+                    skipped_no_pairs: list.no_pairs_by_patch.get(pi).copied().unwrap_or(0),
+                    done: rs.len(),
+                    unstable: u,
+                    unstable_fraction: if rs.is_empty() { 0.0 } else { u as f64 / rs.len() as f64 },
+                    pairs: [
+                        rs.iter().map(|r| r.case.pairs).min().unwrap_or(0),
+                        rs.iter().map(|r| r.case.pairs).max().unwrap_or(0),
+                    ],
+                    classes: class_summaries(&def.solve, &rs, false),
+                });
+            }
+        }
+    }
+    let n_unstable = records.iter().filter(|r| unstable(r)).count();
+    Summary {
+        version: def.version.clone(),
+        kind: if is_macro { "macro" } else { "meso" }.into(),
+        units: "SI: lengths in m, areas in m^2, frequencies in Hz, DvR = Re/Im (dimensionless)"
+            .into(),
+        scene: def.scene.clone(),
+        dofs: def.dofs,
+        methods: def.solve.clone(),
+        params: def.study.clone(),
+        contact_grid: GridSummary {
+            pairs: def.grid.n,
+            spacing_m: def.grid.spacing_m,
+            face_m: def.grid.face_m,
+        },
+        cases: list.cases.len(),
+        cases_done: records.len(),
+        complete: records.len() == list.cases.len(),
+        skipped: list.skipped.clone(),
+        failed: records.iter().filter(|r| r.error.is_some()).count(),
+        unstable_cases: n_unstable,
+        unstable_fraction: if records.is_empty() {
+            0.0
+        } else {
+            n_unstable as f64 / records.len() as f64
+        },
+        max_backward_error: records.iter().map(|r| r.max_backward_error).fold(0.0, f64::max),
+        by_mu,
+        by_patch,
+        warnings: def.warnings(list),
+        timings: "timings.jsonl (per case) and timings.json (totals): wall times are kept out of \
+                  results.jsonl and summary.json so that those are reproducible byte for byte"
+            .into(),
+    }
+}
+
+/// `timings.json`: where the time of the cases went (s).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TimingSummary {
+    /// Cases timed.
+    pub cases: usize,
+    /// Sum over the cases of each stage (s).
+    pub total: Timing,
+    /// Mean per case of each stage (s).
+    pub mean: Timing,
+}
+
+impl TimingSummary {
+    /// Totals and means of `timings`.
+    pub fn of(timings: &[Timing]) -> Self {
+        let mut total = Timing {
+            id: "total".into(),
+            ..Timing::default()
+        };
+        for t in timings {
+            total.contact_s += t.contact_s;
+            total.operator_s += t.operator_s;
+            total.basis_s += t.basis_s;
+            total.projection_s += t.projection_s;
+            total.solve_s += t.solve_s;
+            total.expansion_s += t.expansion_s;
+            total.total_s += t.total_s;
+        }
+        let n = timings.len().max(1) as f64;
+        let mean = Timing {
+            id: "mean".into(),
+            contact_s: total.contact_s / n,
+            operator_s: total.operator_s / n,
+            basis_s: total.basis_s / n,
+            projection_s: total.projection_s / n,
+            solve_s: total.solve_s / n,
+            expansion_s: total.expansion_s / n,
+            total_s: total.total_s / n,
+        };
+        Self {
+            cases: timings.len(),
+            total,
+            mean,
+        }
+    }
+}
