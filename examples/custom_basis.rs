@@ -2,23 +2,21 @@
 //! modes plus `count` smoothed random vectors (`K_c^-1 M_c r`, one static solve each),
 //! implemented against the public `ReductionBasis` trait with the shared machinery of
 //! `squeal::core::reduction`, registered into `squeal::registry()` at run time, and
-//! compared with the built-in `enriched` basis on a coarse build of the default scene
-//! (reference: full-order `arpack`).
+//! compared by the library's benchmark (`squeal::analysis::bench`) with the built-in
+//! bases on a coarse build of the default scene (reference: full-order `arpack`).
 //!
 //! ```text
 //! cargo run --release --example custom_basis
 //! ```
 
+use squeal::analysis::bench::{bench_case, BenchOptions};
 use squeal::analysis::pipeline::Prepared;
 use squeal::core::faer::Mat;
-use squeal::core::qep::ComplexModes;
 use squeal::core::reduction::{
     coupled_real_modes, m_orthonormal_extend, m_orthonormalize, sparse_times, StaticSolver,
     DEFAULT_RANK_TOL,
 };
-use squeal::core::{
-    Basis, BasisRequest, EigenParams, Params, ReducedOperator, ReductionBasis, Result,
-};
+use squeal::core::{Basis, BasisRequest, Params, ReductionBasis, Result};
 use squeal::scene::Scene;
 use std::time::Instant;
 
@@ -65,32 +63,10 @@ impl ReductionBasis for ModesPlusRandom {
     }
 }
 
-/// Largest relative frequency error, largest DvR error and missed modes (no partner
-/// within 1 %) of `got` against `reference`.
-fn errors(reference: &ComplexModes, got: &ComplexModes) -> (f64, f64, usize) {
-    let (mut df, mut dd, mut missed) = (0.0f64, 0.0f64, 0);
-    let mut used = vec![false; got.len()];
-    for i in 0..reference.len() {
-        let best = (0..got.len()).filter(|&j| !used[j]).min_by(|&a, &b| {
-            let da = (reference.lambda[i] - got.lambda[a]).norm();
-            let db = (reference.lambda[i] - got.lambda[b]).norm();
-            da.total_cmp(&db)
-        });
-        match best {
-            Some(j) if (got.freq_hz[j] / reference.freq_hz[i] - 1.0).abs() <= 0.01 => {
-                used[j] = true;
-                df = df.max((got.freq_hz[j] / reference.freq_hz[i] - 1.0).abs());
-                dd = dd.max((got.dvr[j] - reference.dvr[i]).abs());
-            }
-            _ => missed += 1,
-        }
-    }
-    (df, dd, missed)
-}
-
-fn main() -> std::result::Result<(), Box<dyn std::error::Error>> {
-    let start = Instant::now();
-    let mut reg = squeal::registry();
+/// Registers `modes+random` (options `cutoff_factor`, default 1.5, and `count`, default
+/// 40) into `reg`: from then on every tool that lists the registry's bases, `squeal
+/// bench` included, runs it.
+pub fn register(reg: &mut squeal::core::Registry) {
     reg.bases.register(
         "modes+random",
         "modes plus smoothed random vectors",
@@ -103,31 +79,35 @@ fn main() -> std::result::Result<(), Box<dyn std::error::Error>> {
             Ok(basis)
         },
     );
+}
+
+fn main() -> std::result::Result<(), Box<dyn std::error::Error>> {
+    let start = Instant::now();
+    let mut reg = squeal::registry();
+    register(&mut reg);
 
     let mut scene = Scene::builtin("pin-on-disc")?;
     scene.mesh.max_freq_hz = 4000.0;
     scene.mesh.pin_face_elements = 6;
-    let fmax = 3000.0;
     let mu = 0.7;
     let prep = Prepared::new(&reg, scene, "coarse pin-on-disc")?;
     let eq = prep.equilibrium(&reg, "lcp", "lagrange", mu)?;
     let op = prep.operator(&eq.eq.active)?;
-    let params = EigenParams {
-        fmin_hz: 0.0,
-        fmax_hz: fmax,
-        tol: 1e-12,
-        ..EigenParams::default()
-    };
-    let arpack = reg.eigen.create("arpack", &Params::new())?;
-    let dense = reg.eigen.create("dense", &Params::new())?;
-    let t = Instant::now();
-    let reference = arpack.solve_frictional(&op, mu, &params)?;
+    // the benchmark of the library, unchanged: it finds `modes+random` in the registry
+    let mut opts = BenchOptions::all(&reg);
+    opts.band_hz = [0.0, 3000.0];
+    opts.bases.retain(|b| b != "none");
+    opts.eigens = vec!["dense".into()];
+    let (reference, runs) = bench_case(&reg, "example", &op, mu, &opts, None, |_| {})?;
     println!(
-        "coarse pin-on-disc, mu = {mu}: n_c = {}, reference `arpack`: {} modes in 0-{fmax} Hz \
-         ({:.2} s)",
+        "coarse pin-on-disc, mu = {mu}: n_c = {}, reference `{}`: {} modes in 0-{} Hz, {} \
+         unstable ({:.2} s)",
         op.dim(),
-        reference.len(),
-        t.elapsed().as_secs_f64()
+        reference.eigen,
+        reference.modes,
+        opts.band_hz[1],
+        reference.unstable.len(),
+        reference.time_s
     );
     println!(
         "{:<14} {:>5} {:>8} {:>8} {:>10} {:>10} {:>10} {:>7} {:>9}",
@@ -139,42 +119,23 @@ fn main() -> std::result::Result<(), Box<dyn std::error::Error>> {
         "max dDvR",
         "max eta",
         "missed",
-        "unstable"
+        "missed u."
     );
-    for name in ["modes+random", "enriched", "modes"] {
-        let basis = reg.bases.create(name, &Params::new())?;
-        let b = basis.build(&BasisRequest {
-            op: &op,
-            mu,
-            band_hz: (0.0, fmax),
-            modal: arpack.as_ref(),
-            reduced: dense.as_ref(),
-            params: &params,
-        })?;
-        let red = ReducedOperator::new(&op, b)?;
-        let wide = EigenParams {
-            fmax_hz: 1.01 * fmax,
-            ..params.clone()
-        };
-        let s = red.solve(&op, mu, dense.as_ref(), &wide)?;
-        let (df, dd, missed) = errors(&reference, &s.modes);
-        let eta = s.modes.backward_error.iter().fold(0.0f64, |a, &b| a.max(b));
-        let unstable = (0..s.modes.len())
-            .filter(|&i| s.modes.is_unstable(i, 1e-8) && s.modes.freq_hz[i] <= fmax)
-            .count();
+    for r in runs.iter().filter(|r| !r.reference) {
+        let e = &r.errors;
         println!(
-            "{name:<14} {:>5} {:>8.3} {:>8.3} {df:>10.2e} {dd:>10.2e} {eta:>10.2e} {missed:>7} {unstable:>9}",
-            s.basis_size,
-            s.basis_time_s,
-            s.projection_time_s + s.solve_time_s + s.expansion_time_s,
+            "{:<14} {:>5} {:>8.3} {:>8.3} {:>10.2e} {:>10.2e} {:>10.2e} {:>7} {:>9}",
+            r.basis,
+            r.basis_size,
+            r.setup_s,
+            r.solve_s,
+            e.max_rel_freq_err,
+            e.max_abs_dvr_err,
+            e.max_backward_error,
+            e.missed_modes,
+            e.missed_unstable
         );
     }
-    let ref_unstable = (0..reference.len())
-        .filter(|&i| reference.is_unstable(i, 1e-8))
-        .count();
-    println!(
-        "reference: {ref_unstable} unstable; total {:.1} s",
-        start.elapsed().as_secs_f64()
-    );
+    println!("total {:.1} s", start.elapsed().as_secs_f64());
     Ok(())
 }

@@ -668,46 +668,19 @@ struct Errors {
     false_unstable: usize,
 }
 
-/// Matches every reference mode to its nearest unused reduced mode (the
-/// `tests/stability.rs` helper, with the unstable-mode bookkeeping).
+/// The bench's comparison ([`squeal::analysis::bench::compare`]) in the band `[0, fmax]`.
 fn compare(reference: &ComplexModes, reduced: &ComplexModes, fmax: f64) -> Errors {
-    let unstable = |m: &ComplexModes, i: usize| m.is_unstable(i, 1e-8);
-    let mut e = Errors::default();
-    let mut used = vec![false; reduced.len()];
-    for i in 0..reference.len() {
-        let best = (0..reduced.len())
-            .filter(|&j| !used[j])
-            .map(|j| (j, (reference.lambda[i] - reduced.lambda[j]).norm()))
-            .min_by(|a, b| a.1.total_cmp(&b.1));
-        let Some((j, _)) = best else {
-            e.missing += 1;
-            continue;
-        };
-        let df = (reduced.freq_hz[j] - reference.freq_hz[i]).abs() / reference.freq_hz[i];
-        if df > 0.01 {
-            e.missing += 1;
-            continue;
-        }
-        used[j] = true;
-        e.freq = e.freq.max(df);
-        e.dvr = e.dvr.max((reduced.dvr[j] - reference.dvr[i]).abs());
-        if unstable(reference, i) {
-            e.unstable_ref += 1;
-            e.unstable_found += usize::from(unstable(reduced, j));
-        } else if unstable(reduced, j) {
-            e.false_unstable += 1;
-        }
+    let e = squeal::analysis::bench::compare(reference, reduced, [0.0, fmax], 1e-8);
+    Errors {
+        missing: e.missed_modes,
+        extra: e.extra_modes,
+        freq: e.max_rel_freq_err,
+        dvr: e.max_abs_dvr_err,
+        backward: e.max_backward_error,
+        unstable_ref: e.reference_unstable,
+        unstable_found: e.reference_unstable - e.missed_unstable,
+        false_unstable: e.false_unstable,
     }
-    for j in 0..reduced.len() {
-        if reduced.freq_hz[j] <= fmax {
-            e.backward = e.backward.max(reduced.backward_error[j]);
-            if !used[j] {
-                e.extra += 1;
-                e.false_unstable += usize::from(unstable(reduced, j));
-            }
-        }
-    }
-    e
 }
 
 /// Run by `scripts/acceptance.sh` (10-25 minutes: three full-order `arpack` solves of

@@ -1,5 +1,6 @@
 //! The `squeal` command line.
 
+mod bench;
 mod equilibrium;
 mod modes;
 mod scene_cmd;
@@ -10,6 +11,10 @@ mod validate;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use squeal_scene::Scene;
+
+/// Counts heap allocations so `squeal bench` can report each run's peak memory.
+#[global_allocator]
+static HEAP: peak_alloc::PeakAlloc = peak_alloc::PeakAlloc;
 
 /// Brake-squeal stability analysis.
 #[derive(Parser)]
@@ -160,6 +165,57 @@ enum Command {
         law: String,
         /// Output directory.
         #[arg(long)]
+        out: std::path::PathBuf,
+    },
+    /// The solver benchmark: every registered basis x eigen solver (and full order) on
+    /// the same frictional operator against full-order `arpack` at a tight tolerance:
+    /// time (setup, solve), peak memory, basis size, errors, missed and false unstable
+    /// modes, backward errors. Writes bench.json, bench-summary.json and error-vs-time /
+    /// error-vs-size charts; `--stress` runs the stress set instead (stress.json,
+    /// stress-table.json).
+    Bench {
+        /// Scene file (TOML) or embedded scene name; default: `pin-on-disc`.
+        scene: Option<String>,
+        /// Operator directory (as written by `squeal export`) instead of a scene.
+        #[arg(long)]
+        operator: Option<std::path::PathBuf>,
+        /// Friction coefficients, comma separated (one operator each).
+        #[arg(long, value_delimiter = ',', default_value = "0.3,0.7")]
+        mu: Vec<f64>,
+        /// Bases, comma separated (`none` = full order); default: `none` and every
+        /// registered basis.
+        #[arg(long, value_delimiter = ',')]
+        bases: Vec<String>,
+        /// Eigen solvers, comma separated; default: every registered one.
+        #[arg(long, value_delimiter = ',')]
+        eigens: Vec<String>,
+        /// Basis parameter variants run besides the defaults, `key=v1,v2` (by every basis
+        /// that accepts the key); `--vary none` for defaults only.
+        #[arg(long, default_value = "cutoff_factor=2.5")]
+        vary: Vec<String>,
+        /// Frequency band `FMIN:FMAX` (Hz).
+        #[arg(long, default_value = "0:10000")]
+        band: String,
+        /// Tolerance of the benchmarked eigen solvers.
+        #[arg(long, default_value_t = 1e-10)]
+        tol: f64,
+        /// Full-order reference solver.
+        #[arg(long, default_value = "arpack")]
+        reference: String,
+        /// Tolerance of the reference.
+        #[arg(long, default_value_t = 1e-12)]
+        reference_tol: f64,
+        /// Run the stress set (cases built to break methods) instead of the mu list.
+        #[arg(long)]
+        stress: bool,
+        /// Equilibrium solver plugin.
+        #[arg(long, default_value = "lcp")]
+        equilibrium: String,
+        /// Contact law plugin.
+        #[arg(long, default_value = "lagrange")]
+        law: String,
+        /// Output directory.
+        #[arg(long, default_value = "out/bench")]
         out: std::path::PathBuf,
     },
     /// Parameter sweeps.
@@ -532,6 +588,67 @@ fn run() -> Result<()> {
                 "wrote {}/{{sweep.csv,summary.json,*.svg,*.png}}",
                 out.display()
             );
+        }
+        Command::Bench {
+            scene,
+            operator,
+            mu,
+            bases,
+            eigens,
+            vary,
+            band,
+            tol,
+            reference,
+            reference_tol,
+            stress,
+            equilibrium,
+            law,
+            out,
+        } => {
+            let mut opts = squeal_analysis::bench::BenchOptions::all(&registry);
+            if !bases.is_empty() {
+                opts.bases = bases;
+            }
+            if !eigens.is_empty() {
+                opts.eigens = eigens;
+            }
+            for name in opts.bases.iter().filter(|b| *b != "none") {
+                registry
+                    .bases
+                    .create(name, &squeal_core::Params::new())
+                    .with_context(|| format!("--bases: `{name}`"))?;
+            }
+            for name in opts.eigens.iter().chain([&reference]) {
+                registry
+                    .eigen
+                    .create(name, &squeal_core::Params::new())
+                    .with_context(|| format!("--eigens/--reference: `{name}`"))?;
+            }
+            opts.vary = bench::parse_vary(&vary)?;
+            opts.band_hz = parse_band(&band)?;
+            opts.tol = tol;
+            opts.reference_eigen = reference;
+            opts.reference_tol = reference_tol;
+            for (what, t) in [("--tol", tol), ("--reference-tol", reference_tol)] {
+                if !(t > 0.0 && t < 1.0) {
+                    anyhow::bail!("{what}: expected a relative tolerance in (0, 1), got {t}");
+                }
+            }
+            let probe = bench::HeapProbe(&HEAP);
+            bench::run(
+                &registry,
+                &bench::Args {
+                    scene: scene.as_deref(),
+                    operator: operator.as_deref(),
+                    mus: &mu,
+                    out: &out,
+                    opts,
+                    equilibrium: &equilibrium,
+                    law: &law,
+                    stress,
+                },
+                Some(&probe),
+            )?;
         }
         Command::Plugins => {
             for (kind, list) in [

@@ -1070,7 +1070,8 @@ impl<'a> BandRun<'a> {
 /// roots with `|mu| <= RIGID_BODY_REL` are returned as exact zeros (rigid-body motions;
 /// [`finish_modes`] drops them as non-oscillating). The vector is the first block of the
 /// companion eigenvector (`u`), or the second divided by `mu` when `|mu| > 1` (the better
-/// conditioned of the two). A singular `M` (massless DOFs) is an error. Cost: `O((2n)^3)`.
+/// conditioned of the two). A singular `M` (massless DOFs) is an error. Cost: `O((2n)^3)`,
+/// or `O(n^3)` when `C = 0`: the eigenvalues `t` of `M_s^-1 K_s` give `mu = +-sqrt(-t)`.
 pub fn dense_qep(qep: &Qep) -> Result<(Vec<c64>, Mat<c64>)> {
     check_qep(qep)?;
     let n = qep.dim();
@@ -1111,8 +1112,9 @@ pub fn dense_qep(qep: &Qep) -> Result<(Vec<c64>, Mat<c64>)> {
             ),
         });
     }
-    // W = M_s^-1 [K_s | C_s]
-    let mut w = Mat::<f64>::zeros(n, 2 * n);
+    // W = M_s^-1 [K_s | C_s] (only M_s^-1 K_s when C = 0)
+    let undamped = qep.c.is_none();
+    let mut w = Mat::<f64>::zeros(n, if undamped { n } else { 2 * n });
     {
         let kd = qep.k.as_ref().to_dense();
         w.as_mut()
@@ -1126,6 +1128,9 @@ pub fn dense_qep(qep: &Qep) -> Result<(Vec<c64>, Mat<c64>)> {
         }
     }
     lu.solve_in_place(w.as_mut());
+    if undamped {
+        return dense_qep_squared(w, gamma);
+    }
     let mut a = Mat::<f64>::zeros(2 * n, 2 * n);
     for i in 0..n {
         a[(i, n + i)] = 1.0;
@@ -1179,6 +1184,46 @@ pub fn dense_qep(qep: &Qep) -> Result<(Vec<c64>, Mat<c64>)> {
             }
         }
     }
+    Ok((lambda, vectors))
+}
+
+/// The undamped branch of [`dense_qep`]: with `C = 0`, `mu^2 = -t` for the eigenvalues
+/// `t` of `W = M_s^-1 K_s` (`n x n`, against `2n x 2n` for the companion form: 8 times
+/// fewer flops), each `t` giving the two roots `mu = +-sqrt(-t)` with the same vector.
+fn dense_qep_squared(w: Mat<f64>, gamma: f64) -> Result<(Vec<c64>, Mat<c64>)> {
+    let n = w.nrows();
+    if (0..n).any(|j| (0..n).any(|i| !w[(i, j)].is_finite())) {
+        return Err(Error::Factorization {
+            what: format!("M~ (dense, n = {n})"),
+            reason: "M~^-1 K~ is not finite: the mass matrix is numerically singular".into(),
+        });
+    }
+    let eig = faer::linalg::solvers::Eigen::new_from_real(w.as_ref()).map_err(|e| {
+        Error::NotConverged {
+            method: "dense non-symmetric eigen (M~^-1 K~, C = 0)".into(),
+            iterations: 0,
+            detail: format!("{e:?}"),
+        }
+    })?;
+    let t = eig.S();
+    let z = eig.U();
+    let mut lambda = Vec::with_capacity(2 * n);
+    let mut cols = Vec::with_capacity(2 * n);
+    for k in 0..n {
+        let root = (-t[k]).sqrt();
+        if !(root.re.is_finite() && root.im.is_finite()) {
+            continue;
+        }
+        for mu in [root, -root] {
+            lambda.push(if mu.norm() <= RIGID_BODY_REL {
+                c64::new(0.0, 0.0)
+            } else {
+                mu * gamma
+            });
+            cols.push(k);
+        }
+    }
+    let vectors = Mat::<c64>::from_fn(n, cols.len(), |r, c| z[(r, cols[c])]);
     Ok((lambda, vectors))
 }
 

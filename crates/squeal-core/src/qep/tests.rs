@@ -326,6 +326,38 @@ fn dense_qep_random_damped_pencils() {
 }
 
 #[test]
+fn dense_qep_undamped_branch_matches_the_companion_form() {
+    // C = 0 takes the n x n branch (M^-1 K); the same pencil with an explicit zero C
+    // takes the 2n companion: same roots, small backward errors, +-lambda pairs
+    for (seed, n) in [(4u64, 5usize), (5, 11), (6, 17)] {
+        let qep = random_qep(n, seed, false);
+        let (lam, u) = dense_qep(&qep).unwrap();
+        assert_eq!(lam.len(), 2 * n);
+        let zero = Qep {
+            c: Some(sparse(&Mat::<f64>::zeros(n, n))),
+            ..qep.clone()
+        };
+        let (want, _) = dense_qep(&zero).unwrap();
+        let scale = want.iter().map(|l| l.norm()).fold(0.0, f64::max);
+        for k in 0..lam.len() {
+            let uk: Vec<c64> = (0..n).map(|r| u[(r, k)]).collect();
+            let be = backward_error(&qep, lam[k], &uk);
+            assert!(be <= 1e-12, "seed {seed}: eta = {be:e} for {}", lam[k]);
+            let d = want
+                .iter()
+                .map(|w| (w - lam[k]).norm())
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                d <= 1e-10 * scale,
+                "seed {seed}: {} not a companion root",
+                lam[k]
+            );
+            assert!(lam.iter().any(|l| (l + lam[k]).norm() <= 1e-12 * scale));
+        }
+    }
+}
+
+#[test]
 fn dense_qep_rigid_body_root_is_zero_and_dropped() {
     // Free-free chain of 3 unit masses: K singular, omega^2 = 0, 1, 3.
     let k = sparse(&dense_of(&[

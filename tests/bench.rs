@@ -1,0 +1,130 @@
+//! The solver benchmark: a basis registered at run time (the `custom_basis` example's)
+//! is benchmarked with no change to the bench code, and the mode comparison behind every
+//! error figure detects what it must.
+
+#[path = "../examples/custom_basis.rs"]
+#[allow(dead_code)]
+mod custom_basis;
+
+use squeal::analysis::bench::{bench_case, compare, speed_ratios, BenchOptions};
+use squeal::analysis::pipeline::Prepared;
+use squeal::core::{c64, FrictionalOperator, Params};
+use squeal::scene::Scene;
+
+fn coarse_operator(reg: &squeal::core::Registry, mu: f64) -> FrictionalOperator {
+    let prep = Prepared::new(reg, Scene::builtin("pin-on-disc-coarse").unwrap(), "coarse").unwrap();
+    let eq = prep.equilibrium(reg, "lcp", "lagrange", mu).unwrap();
+    prep.operator(&eq.eq.active).unwrap()
+}
+
+#[test]
+fn a_basis_registered_at_run_time_appears_in_the_bench() {
+    let mut reg = squeal::registry();
+    let before = BenchOptions::all(&reg).bases;
+    assert!(!before.iter().any(|b| b == "modes+random"));
+    custom_basis::register(&mut reg);
+    let mut opts = BenchOptions::all(&reg);
+    assert!(opts.bases.iter().any(|b| b == "modes+random"));
+    assert!(opts.bases.iter().any(|b| b == "none"));
+    opts.band_hz = [0.0, 4000.0];
+    opts.bases.retain(|b| b != "none");
+    opts.eigens = vec!["dense".into()];
+    opts.vary = vec![("count".into(), vec![10.0])];
+    let mu = 0.7;
+    let op = coarse_operator(&reg, mu);
+    let mut seen = Vec::new();
+    let (reference, runs) = bench_case(&reg, "mu=0.7", &op, mu, &opts, None, |r| {
+        seen.push(format!("{}/{} {}", r.basis, r.eigen, r.basis_opts))
+    })
+    .unwrap();
+    assert!(reference.modes > 5, "reference modes {}", reference.modes);
+    // every registered basis ran (one run each with defaults), the new one also with the
+    // varied parameter only it accepts
+    for b in before.iter().filter(|b| *b != "none") {
+        assert!(
+            runs.iter()
+                .any(|r| &r.basis == b && r.basis_opts.is_empty()),
+            "{b} missing from {seen:?}"
+        );
+        assert!(!runs
+            .iter()
+            .any(|r| &r.basis == b && !r.basis_opts.is_empty()));
+    }
+    let custom: Vec<_> = runs.iter().filter(|r| r.basis == "modes+random").collect();
+    assert_eq!(custom.len(), 2, "{seen:?}");
+    assert_eq!(custom[1].basis_opts, "count=10");
+    for r in &custom {
+        assert_eq!(r.status, "ok");
+        assert!(r.basis_size > 10 && r.basis_size < op.dim());
+        assert!(r.errors.max_rel_freq_err.is_finite());
+        assert!(r.errors.max_backward_error > 0.0);
+        assert_eq!(r.errors.reference_modes, reference.modes);
+    }
+    // 40 random vectors enrich more than 10: a bigger basis, no larger frequency error
+    assert!(custom[0].basis_size > custom[1].basis_size);
+    // the reference is a run of its own, exact against itself
+    let refrun = runs.iter().find(|r| r.reference).unwrap();
+    assert_eq!(refrun.errors.max_rel_freq_err, 0.0);
+    assert_eq!(seen.len(), runs.len());
+    // residue is accurate on this case: it has a speed ratio
+    assert!(speed_ratios(&runs)
+        .iter()
+        .any(|s| s.method == "residue/dense"));
+}
+
+#[test]
+fn the_comparison_counts_missed_false_and_shifted_modes() {
+    let reg = squeal::registry();
+    let mu = 0.7;
+    let op = coarse_operator(&reg, mu);
+    let arpack = reg.eigen.create("arpack", &Params::new()).unwrap();
+    let params = squeal::core::EigenParams {
+        fmax_hz: 4000.0,
+        ..Default::default()
+    };
+    let reference = arpack.solve_frictional(&op, mu, &params).unwrap();
+    let band = [0.0, 4000.0];
+    let unstable: Vec<usize> = (0..reference.len())
+        .filter(|&i| reference.is_unstable(i, 1e-8))
+        .collect();
+    assert!(
+        !unstable.is_empty(),
+        "the coarse scene flutters at mu = 0.7"
+    );
+    let same = compare(&reference, &reference, band, 1e-8);
+    assert_eq!(same.missed_modes, 0);
+    assert_eq!(same.reference_unstable, unstable.len());
+    assert_eq!(same.max_rel_freq_err, 0.0);
+    // drop the unstable mode: one mode and one instability missed
+    let u = unstable[0];
+    let mut dropped = reference.clone();
+    dropped.lambda.remove(u);
+    dropped.freq_hz.remove(u);
+    dropped.dvr.remove(u);
+    dropped.backward_error.remove(u);
+    let e = compare(&reference, &dropped, band, 1e-8);
+    assert!(e.missed_modes >= 1 && e.missed_unstable == 1, "{e:?}");
+    // mirror its real part (a missed instability) and give a neutral mode far from it a
+    // positive one (a false instability)
+    let mut flipped = reference.clone();
+    flipped.lambda[u] = c64::new(-flipped.lambda[u].re, flipped.lambda[u].im);
+    flipped.dvr[u] = -flipped.dvr[u];
+    let fu = reference.freq_hz[u];
+    let neutral = (0..reference.len())
+        .find(|&i| (reference.freq_hz[i] - fu).abs() > 0.05 * fu && reference.dvr[i].abs() < 1e-9)
+        .expect("a neutral mode away from the flutter");
+    let l = reference.lambda[neutral];
+    flipped.lambda[neutral] = c64::new(1e-3 * l.im, l.im);
+    flipped.dvr[neutral] = 1e-3;
+    let e = compare(&reference, &flipped, band, 1e-8);
+    assert_eq!((e.missed_unstable, e.false_unstable), (1, 1), "{e:?}");
+    assert!(e.max_abs_dvr_err > reference.dvr[u], "{e:?}");
+    // shift one frequency by 0.5 %: found, with that error
+    let mut shifted = reference.clone();
+    let k = reference.len() / 2;
+    shifted.lambda[k] *= 1.005;
+    shifted.freq_hz[k] *= 1.005;
+    let e = compare(&reference, &shifted, band, 1e-8);
+    assert_eq!(e.missed_modes, 0);
+    assert!((e.max_rel_freq_err - 0.005).abs() < 1e-9, "{e:?}");
+}
