@@ -239,7 +239,8 @@ pub struct MesoSpec {
     pub layouts: usize,
     /// Fraction of the patches in contact, in (0, 1].
     pub fraction: f64,
-    /// Base seed; layout `l` of patch size `p` uses [`derive_seed`]`(seed, p, l)`.
+    /// Base seed; layout `l` of patch side `p` uses [`derive_seed`]`(seed, p in um, l)`,
+    /// so a layout does not change when other patch sizes are added or removed.
     pub seed: u64,
 }
 
@@ -270,8 +271,11 @@ pub struct SolveSpec {
     pub tol: f64,
     /// A mode is unstable when its DvR exceeds this.
     pub dvr_tol: f64,
-    /// Frequencies (Hz) that classify unstable modes (nearest class).
+    /// Frequencies (Hz) that classify unstable modes: a mode belongs to the nearest
+    /// class within `class_width` (relative), else to none.
     pub classes_hz: Vec<f64>,
+    /// Relative half-width of a class: `|f - c| <= class_width * c`.
+    pub class_width: f64,
 }
 
 impl SolveSpec {
@@ -287,19 +291,25 @@ impl SolveSpec {
         if !(self.dvr_tol.is_finite() && self.dvr_tol >= 0.0) {
             return Err(input("--dvr-tol", format!("expected a DvR threshold >= 0, got {}", self.dvr_tol)));
         }
-        if self.classes_hz.is_empty() || self.classes_hz.iter().any(|c| !(*c > 0.0)) {
+        if self.classes_hz.is_empty() || self.classes_hz.iter().any(|c| !(c.is_finite() && *c > 0.0)) {
             return Err(input("--classes", format!("expected frequencies > 0 Hz, got {:?}", self.classes_hz)));
+        }
+        if !(self.class_width > 0.0 && self.class_width < 1.0) {
+            return Err(input(
+                "--class-width",
+                format!("expected a relative half-width in (0, 1), got {}", self.class_width),
+            ));
         }
         Ok(())
     }
 
-    /// The nearest class of a frequency.
-    pub fn class_of(&self, freq_hz: f64) -> f64 {
+    /// The class of a frequency: the nearest class frequency within `class_width`.
+    pub fn class_of(&self, freq_hz: f64) -> Option<f64> {
         self.classes_hz
             .iter()
             .copied()
+            .filter(|c| (freq_hz - c).abs() <= self.class_width * c)
             .min_by(|a, b| (a - freq_hz).abs().total_cmp(&(b - freq_hz).abs()))
-            .unwrap_or(0.0)
     }
 
     fn eigen_params(&self) -> EigenParams {
@@ -431,15 +441,15 @@ pub struct CaseList {
     pub no_pairs_by_patch: Vec<usize>,
 }
 
-/// The seed of layout `layout` of patch size number `patch` (splitmix64 of the three).
-pub fn derive_seed(base: u64, patch: usize, layout: usize) -> u64 {
+/// The seed of layout `layout` of the patch side `patch_um` (um): splitmix64 of the three.
+pub fn derive_seed(base: u64, patch_um: u64, layout: usize) -> u64 {
     let mix = |mut z: u64| {
         z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         z ^ (z >> 31)
     };
-    mix(mix(mix(base) ^ patch as u64) ^ layout as u64)
+    mix(mix(mix(base) ^ patch_um) ^ layout as u64)
 }
 
 fn um(v: f64) -> i64 {
@@ -469,6 +479,52 @@ fn positive(option: &str, v: &[f64], what: &str) -> Result<()> {
     Ok(())
 }
 
+/// Every start and every length of one axis must fit in the face with at least one value
+/// of the other list (combinations that do not fit are skipped and counted).
+fn check_axis(
+    start_opt: &str,
+    len_opt: &str,
+    starts: &Axis,
+    lens: &[f64],
+    size: f64,
+    tol: f64,
+) -> Result<()> {
+    let min_len = lens.iter().copied().fold(f64::INFINITY, f64::min);
+    if let Some(l) = lens.iter().find(|l| **l > size + tol) {
+        return Err(input(
+            len_opt,
+            format!(
+                "zone size {l} m is larger than the pin face ({size} m): expected values in (0, {size}] m"
+            ),
+        ));
+    }
+    if let Axis::Values(v) = starts {
+        let min_start = v.iter().copied().fold(f64::INFINITY, f64::min);
+        if let Some(x) = v.iter().find(|x| **x + min_len > size + tol) {
+            return Err(input(
+                start_opt,
+                format!(
+                    "a zone starting at {x} m leaves the pin face ({size} m) even with the \
+                     smallest {len_opt} {min_len} m: expected {start_opt} in [0, {}] m (from \
+                     the face corner)",
+                    size - min_len
+                ),
+            ));
+        }
+        if let Some(l) = lens.iter().find(|l| min_start + **l > size + tol) {
+            return Err(input(
+                len_opt,
+                format!(
+                    "a zone of {l} m leaves the pin face ({size} m) even at the smallest \
+                     {start_opt} {min_start} m: expected {len_opt} <= {} m",
+                    size - min_start
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 impl StudyDef {
     /// The case list (sorted by id), with the skipped zones counted. Errors name the
     /// option when no case is left or an input is out of range.
@@ -483,6 +539,8 @@ impl StudyDef {
                 check_mu(&s.mu)?;
                 positive("--a", &s.a_m, "zone length")?;
                 positive("--b", &s.b_m, "zone width")?;
+                check_axis("--x0", "--a", &s.x0, &s.a_m, face[0], tol)?;
+                check_axis("--y0", "--b", &s.y0, &s.b_m, face[1], tol)?;
                 for &mu in &s.mu {
                     for &a in &s.a_m {
                         for &b in &s.b_m {
@@ -566,7 +624,30 @@ impl StudyDef {
                 if let Some(p) = s.patch_m.iter().find(|p| **p > a.min(b) * (1.0 + 1e-9)) {
                     return Err(input(
                         "--patch",
-                        format!("patch side {p} m is larger than the region ({a} x {b} m)"),
+                        format!(
+                            "patch side {p} m does not fit in the region ({a} x {b} m, --region): \
+                             expected patch sides <= {} m",
+                            a.min(b)
+                        ),
+                    ));
+                }
+                let sp = self.grid.spacing_m[0].max(self.grid.spacing_m[1]);
+                if let Some(p) = s.patch_m.iter().find(|p| **p < sp * (1.0 - 1e-9)) {
+                    let need = (self.grid.face_m[0].max(self.grid.face_m[1]) / p).ceil();
+                    return Err(input(
+                        "--patch",
+                        format!(
+                            "patch side {:.3} mm is smaller than the contact grid spacing \
+                             {:.3} mm of the scene ({} x {} pairs): expected patch sides >= \
+                             {:.3} mm, or a scene with a finer contact grid \
+                             (mesh.pin_face_elements >= {need}; the paper used 0.2 mm contact \
+                             elements)",
+                            p * 1e3,
+                            sp * 1e3,
+                            self.grid.n[0],
+                            self.grid.n[1],
+                            sp * 1e3
+                        ),
                     ));
                 }
                 if s.layouts == 0 {
@@ -578,12 +659,12 @@ impl StudyDef {
                         format!("expected a fraction of the patches in (0, 1], got {}", s.fraction),
                     ));
                 }
-                for (pi, &patch) in s.patch_m.iter().enumerate() {
+                for &patch in &s.patch_m {
                     let mut empty = 0;
                     for l in 0..s.layouts {
                         let zone = Zone::Plateaus {
                             patch_m: patch,
-                            seed: derive_seed(s.seed, pi, l),
+                            seed: derive_seed(s.seed, um(patch).unsigned_abs(), l),
                             fraction: Some(s.fraction),
                             count: None,
                             region_m: Some(s.region_m),
@@ -657,19 +738,8 @@ impl StudyDef {
     /// Human-readable warnings (patches below the contact grid spacing, skipped cases).
     pub fn warnings(&self, list: &CaseList) -> Vec<String> {
         let mut w = Vec::new();
-        let sp = self.grid.spacing_m[0].max(self.grid.spacing_m[1]);
         if let StudySpec::Meso(s) = &self.study {
             for (i, &p) in s.patch_m.iter().enumerate() {
-                if p < sp * (1.0 - 1e-9) {
-                    w.push(format!(
-                        "patch {:.3} mm is smaller than the contact grid spacing {:.3} mm: a patch \
-                         holds at most one row/column of pairs and many hold none, so layouts \
-                         sample the grid rather than resolve plateaus (the paper used 0.2 mm \
-                         contact elements; raise mesh.pin_face_elements)",
-                        p * 1e3,
-                        sp * 1e3
-                    ));
-                }
                 if let Some(&n) = list.no_pairs_by_patch.get(i) {
                     if n > 0 {
                         w.push(format!(
@@ -709,8 +779,9 @@ pub struct UnstableMode {
     pub dvr: f64,
     /// Backward error on the full operator.
     pub backward_error: f64,
-    /// The nearest class frequency (Hz).
-    pub class_hz: f64,
+    /// Its class (Hz; see [`SolveSpec::class_of`]), absent outside every class.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub class_hz: Option<f64>,
 }
 
 /// The result of one case: a line of `results.jsonl` (no times, see the module docs).
@@ -873,8 +944,8 @@ impl StudyDir {
 /// How to run a study.
 #[derive(Debug, Clone, Default)]
 pub struct RunOptions {
-    /// Parallel cases (each with its own [`Method`]); 0 or 1 runs them one after the other
-    /// on the calling thread (each case still uses every core through faer).
+    /// Parallel cases (each worker with its own [`Method`]); 0 or 1 runs them one after
+    /// the other on the calling thread (each case still uses every core through faer).
     pub jobs: usize,
     /// Only this part of the cases.
     pub shard: Option<Shard>,
@@ -949,17 +1020,40 @@ fn claim(dir: &StudyDir, def: &StudyDef, resume: bool) -> Result<()> {
     jsonl::write_atomic(&dir.study(), text.as_bytes()).map_err(|e| files(&dir.study(), e))
 }
 
+/// What [`run`] tells its observer.
+#[derive(Debug, Clone, Copy)]
+pub enum Progress<'a> {
+    /// Before the first case: `resumed` cases of the shard were already done, `todo`
+    /// will be computed now, of `shard` cases in this run's shard.
+    Start {
+        /// Cases found done.
+        resumed: usize,
+        /// Cases to compute now.
+        todo: usize,
+        /// Cases of the shard.
+        shard: usize,
+    },
+    /// A case finished and was appended (`done` of `todo` so far in this run).
+    Case {
+        /// Cases computed so far by this run.
+        done: usize,
+        /// The record just appended.
+        record: &'a Record,
+    },
+}
+
 /// Runs (or resumes) a study in `dir` on `model` (built from the definition's scene).
 /// Every finished case is appended at once; when the run ends, `results.jsonl` and
 /// `timings.jsonl` are rewritten sorted by id and `summary.json`, `timings.json` written
-/// from every record in the directory. `progress(done, total, record)` sees each new case.
+/// from every record in the directory. With `jobs > 1`, `jobs` rayon workers each own a
+/// [`Method`] and take the next case until none is left.
 pub fn run(
     registry: &Registry,
     model: &Model,
     def: &StudyDef,
     dir: &StudyDir,
     opts: &RunOptions,
-    progress: &(dyn Fn(usize, usize, &Record) + Sync),
+    progress: &(dyn Fn(Progress<'_>) + Sync),
 ) -> Result<RunReport> {
     def.solve.check()?;
     if model.dofs.n_free() != def.dofs {
@@ -982,63 +1076,77 @@ pub fn run(
         .map(|(_, c)| c)
         .collect();
     let resumed = shard.iter().filter(|c| done.contains(&c.id)).count();
-    let mut todo: Vec<&Case> = shard.iter().copied().filter(|c| !done.contains(&c.id)).collect();
-    let remaining_after = todo.len().saturating_sub(opts.max_cases.unwrap_or(usize::MAX));
-    todo.truncate(opts.max_cases.unwrap_or(usize::MAX));
-    let total = todo.len();
-    let lock = Mutex::new(0usize);
-    let io_error: Mutex<Option<StudyError>> = Mutex::new(None);
+    let mut todo: Vec<&Case> = shard
+        .iter()
+        .copied()
+        .filter(|c| !done.contains(&c.id))
+        .collect();
+    let limit = opts.max_cases.unwrap_or(usize::MAX);
+    let remaining = todo.len().saturating_sub(limit);
+    todo.truncate(limit);
+    progress(Progress::Start {
+        resumed,
+        todo: todo.len(),
+        shard: shard.len(),
+    });
+    let counter = Mutex::new(0usize);
+    let failure: Mutex<Option<StudyError>> = Mutex::new(None);
+    let failed = || failure.lock().map(|f| f.is_some()).unwrap_or(true);
+    let fail = |e: StudyError| {
+        let mut f = failure.lock().unwrap_or_else(|p| p.into_inner());
+        f.get_or_insert(e);
+    };
+    // appends a finished case; false stops the run (an I/O error)
     let finish = |rec: Record, t: Timing| -> bool {
-        let mut n = lock.lock().unwrap_or_else(|e| e.into_inner());
+        let mut n = counter.lock().unwrap_or_else(|p| p.into_inner());
         let res = jsonl::append(&dir.results(), &rec)
             .map_err(|e| files(&dir.results(), e))
             .and_then(|_| jsonl::append(&dir.timings(), &t).map_err(|e| files(&dir.timings(), e)));
         if let Err(e) = res {
-            *io_error.lock().unwrap_or_else(|e| e.into_inner()) = Some(e);
+            fail(e);
             return false;
         }
         *n += 1;
-        progress(*n, total, &rec);
+        progress(Progress::Case {
+            done: *n,
+            record: &rec,
+        });
         true
     };
     let rotation = def.rotation;
-    if opts.jobs <= 1 {
-        let mut method = def.solve.method(registry)?;
-        for case in &todo {
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let worker = || match def.solve.method(registry) {
+        Ok(mut method) => loop {
+            if failed() {
+                break;
+            }
+            let i = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+            let Some(case) = todo.get(i) else { break };
             let (rec, t) = run_case(model, rotation, &def.solve, case, &mut method);
             if !finish(rec, t) {
                 break;
             }
-        }
+        },
+        Err(e) => fail(e),
+    };
+    let workers = opts.jobs.clamp(1, todo.len().max(1));
+    if workers == 1 {
+        worker();
     } else {
-        use rayon::prelude::*;
         let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(opts.jobs)
+            .num_threads(workers)
             .build()
-            .map_err(|e| input("--jobs", format!("cannot start {} workers: {e}", opts.jobs)))?;
-        pool.install(|| {
-            todo.par_iter().with_max_len(1).for_each_init(
-                || def.solve.method(registry),
-                |method, case| {
-                    if io_error.lock().map(|e| e.is_some()).unwrap_or(true) {
-                        return;
-                    }
-                    let (rec, t) = match method {
-                        Ok(m) => run_case(model, rotation, &def.solve, case, m),
-                        Err(e) => {
-                            *io_error.lock().unwrap_or_else(|e| e.into_inner()) =
-                                Some(input("--basis/--eigen", e.to_string()));
-                            return;
-                        }
-                    };
-                    finish(rec, t);
-                },
-            );
+            .map_err(|e| input("--jobs", format!("cannot start {workers} workers: {e}")))?;
+        pool.scope(|s| {
+            for _ in 0..workers {
+                s.spawn(|_| worker());
+            }
         });
     }
-    if let Some(e) = io_error.into_inner().unwrap_or_else(|e| e.into_inner()) {
+    if let Some(e) = failure.into_inner().unwrap_or_else(|p| p.into_inner()) {
         return Err(e);
     }
+    let computed = *counter.lock().unwrap_or_else(|p| p.into_inner());
     let records = dir.records()?;
     let timings = dir.timing_records()?;
     let (summary, tsum) = finalize(dir, def, &list, records, timings)?;
@@ -1046,8 +1154,8 @@ pub fn run(
         cases: list.cases.len(),
         shard_cases: shard.len(),
         resumed,
-        computed: total,
-        remaining: remaining_after,
+        computed,
+        remaining,
         summary,
         timings: tsum,
     })
@@ -1157,6 +1265,8 @@ pub struct ClassSummary {
     pub class_hz: f64,
     /// Cases with an unstable mode of this class.
     pub cases: usize,
+    /// `cases` over the cases done of the group (friction coefficient, patch size).
+    pub unstable_fraction: f64,
     /// Smallest, mean and largest zone area of those cases (m^2).
     pub area_m2: [f64; 3],
     /// Frequency range of the class's unstable modes (Hz).
@@ -1179,6 +1289,8 @@ pub struct MuSummary {
     pub unstable: usize,
     /// Unstable cases per class.
     pub classes: Vec<ClassSummary>,
+    /// Cases with an unstable mode outside every class.
+    pub unclassified: usize,
 }
 
 /// Results of one patch size (mesoscopic studies).
@@ -1190,8 +1302,6 @@ pub struct PatchSummary {
     pub patch_m: f64,
     /// Patch sides actually cut (the region divided into whole patches) (m).
     pub patch_side_m: [f64; 2],
-    /// Whether the patch is smaller than the contact grid spacing (see the warnings).
-    pub below_grid_spacing: bool,
     /// Layouts asked for.
     pub layouts: usize,
     /// Layouts skipped (no contact pair under their patches).
@@ -1206,6 +1316,8 @@ pub struct PatchSummary {
     pub pairs: [usize; 2],
     /// Unstable layouts per class.
     pub classes: Vec<ClassSummary>,
+    /// Layouts with an unstable mode outside every class.
+    pub unclassified: usize,
 }
 
 /// `summary.json`: a pure function of the definition and the records.
@@ -1273,11 +1385,11 @@ fn class_summaries(solve: &SolveSpec, records: &[&Record], with_zones: bool) -> 
             let of: Vec<&Record> = records
                 .iter()
                 .copied()
-                .filter(|r| r.unstable.iter().any(|m| m.class_hz == c))
+                .filter(|r| r.unstable.iter().any(|m| m.class_hz == Some(c)))
                 .collect();
             let modes: Vec<&UnstableMode> = of
                 .iter()
-                .flat_map(|r| r.unstable.iter().filter(|m| m.class_hz == c))
+                .flat_map(|r| r.unstable.iter().filter(|m| m.class_hz == Some(c)))
                 .collect();
             let range = |v: &mut dyn Iterator<Item = f64>| -> [f64; 2] {
                 v.fold([f64::INFINITY, f64::NEG_INFINITY], |a, x| [a[0].min(x), a[1].max(x)])
@@ -1293,6 +1405,11 @@ fn class_summaries(solve: &SolveSpec, records: &[&Record], with_zones: bool) -> 
             ClassSummary {
                 class_hz: c,
                 cases: of.len(),
+                unstable_fraction: if records.is_empty() {
+                    0.0
+                } else {
+                    of.len() as f64 / records.len() as f64
+                },
                 area_m2: [ar[0], mean, ar[1]],
                 freq_hz: fix(range(&mut modes.iter().map(|m| m.freq_hz))),
                 dvr: fix(range(&mut modes.iter().map(|m| m.dvr))),
@@ -1316,6 +1433,13 @@ fn class_summaries(solve: &SolveSpec, records: &[&Record], with_zones: bool) -> 
         .collect()
 }
 
+fn unclassified(records: &[&Record]) -> usize {
+    records
+        .iter()
+        .filter(|r| r.unstable.iter().any(|m| m.class_hz.is_none()))
+        .count()
+}
+
 /// The summary of `records` (sorted by id, those of `list`).
 pub fn summarize(def: &StudyDef, list: &CaseList, records: &[Record]) -> Summary {
     let is_macro = matches!(def.study, StudySpec::Macro(_));
@@ -1333,12 +1457,12 @@ pub fn summarize(def: &StudyDef, list: &CaseList, records: &[Record]) -> Summary
                 cases: rs.len(),
                 unstable: rs.iter().filter(|r| unstable(r)).count(),
                 classes: class_summaries(&def.solve, &rs, is_macro),
+                unclassified: unclassified(&rs),
             }
         })
         .collect();
     let mut by_patch = Vec::new();
     if let StudySpec::Meso(s) = &def.study {
-        let sp = def.grid.spacing_m[0].max(def.grid.spacing_m[1]);
         let [_, _, a, b] = s.region_m;
         for &mu in &s.mu {
             for (pi, &p) in s.patch_m.iter().enumerate() {
@@ -1353,7 +1477,6 @@ pub fn summarize(def: &StudyDef, list: &CaseList, records: &[Record]) -> Summary
                     mu,
                     patch_m: p,
                     patch_side_m: [a / nx as f64, b / ny as f64],
-                    below_grid_spacing: p < sp * (1.0 - 1e-9),
                     layouts: s.layouts,
                     skipped_no_pairs: list.no_pairs_by_patch.get(pi).copied().unwrap_or(0),
                     done: rs.len(),
@@ -1364,6 +1487,7 @@ pub fn summarize(def: &StudyDef, list: &CaseList, records: &[Record]) -> Summary
                         rs.iter().map(|r| r.case.pairs).max().unwrap_or(0),
                     ],
                     classes: class_summaries(&def.solve, &rs, false),
+                    unclassified: unclassified(&rs),
                 });
             }
         }
