@@ -397,6 +397,9 @@ pub struct StudyDef {
     pub version: String,
     /// Scene (file or embedded name).
     pub scene: String,
+    /// The scene as read, every default filled in (TOML): a resume or a merge with an
+    /// edited scene file is refused.
+    pub scene_toml: String,
     /// Free DOFs of the model.
     pub dofs: usize,
     /// Rotation sense of the disc.
@@ -535,6 +538,27 @@ fn check_axis(
 }
 
 impl StudyDef {
+    /// The definition of a study of `study` solved by `solve` on `model`, built from
+    /// `scene` (named `file`), stamped with this crate's version.
+    pub fn new(
+        file: &str,
+        scene: &squeal_scene::Scene,
+        model: &Model,
+        study: StudySpec,
+        solve: SolveSpec,
+    ) -> Result<Self> {
+        Ok(Self {
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            scene: file.to_string(),
+            scene_toml: scene.to_toml(),
+            dofs: model.dofs.n_free(),
+            rotation: scene.study.rotation,
+            grid: GridInfo::of(model)?,
+            study,
+            solve,
+        })
+    }
+
     /// The case list (sorted by id), with the skipped zones counted. Errors name the
     /// option when no case is left or an input is out of range.
     pub fn cases(&self) -> Result<CaseList> {

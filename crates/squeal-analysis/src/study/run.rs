@@ -221,7 +221,10 @@ fn first_difference(a: &serde_json::Value, b: &serde_json::Value) -> String {
             .iter()
             .find(|(k, v)| y.get(*k) != Some(*v))
             .map(|(k, v)| match y.get(k) {
-                Some(w) => format!("{k}: {}", first_difference(v, w)),
+                Some(w) => match first_difference(v, w) {
+                    d if d.contains(" vs ") => format!("{k}: {d}"),
+                    d => format!("{k}.{d}"),
+                },
                 None => k.clone(),
             })
             .or_else(|| y.keys().find(|k| !x.contains_key(*k)).cloned())

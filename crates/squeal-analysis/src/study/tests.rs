@@ -38,6 +38,7 @@ fn def(study: StudySpec) -> StudyDef {
     StudyDef {
         version: "test".into(),
         scene: "<test>".into(),
+        scene_toml: String::new(),
         dofs: 100,
         rotation: 1.0,
         grid: grid(21, 0.020),
