@@ -98,11 +98,16 @@ fn an_interrupted_study_resumes_to_the_same_bytes() {
     let r = run(&f, &def, &whole, RunOptions::default());
     assert_eq!((r.cases, r.computed, r.remaining), (12, 12, 0));
     assert!(r.summary.complete);
-    assert!(r.summary.unstable_cases > 0, "the coarse rig has unstable zones");
+    assert!(
+        r.summary.unstable_cases > 0,
+        "the coarse rig has unstable zones"
+    );
     assert!(r.summary.unstable_cases < 12);
     let records = StudyDir::new(&whole).records().unwrap();
     assert_eq!(records.len(), 12);
-    assert!(records.iter().all(|r| r.error.is_none() && !r.modes.is_empty()));
+    assert!(records
+        .iter()
+        .all(|r| r.error.is_none() && !r.modes.is_empty()));
 
     // 1. stopped after 5 cases (a batch slot), the last line then torn by a crash
     let part = tmp("part");
@@ -126,7 +131,10 @@ fn an_interrupted_study_resumes_to_the_same_bytes() {
     assert_eq!((r.computed, r.remaining), (5, 7));
     assert_eq!(*seen.lock().unwrap(), [1, 2, 3, 4, 5]);
     assert!(!r.summary.complete);
-    assert_ne!(bytes(&part, "results.jsonl"), bytes(&whole, "results.jsonl"));
+    assert_ne!(
+        bytes(&part, "results.jsonl"),
+        bytes(&whole, "results.jsonl")
+    );
     let results = part.join("results.jsonl");
     let text = std::fs::read_to_string(&results).unwrap();
     let last = text.lines().last().unwrap();
@@ -162,7 +170,9 @@ fn an_interrupted_study_resumes_to_the_same_bytes() {
     std::fs::copy(whole.join("study.json"), killed.join("study.json")).unwrap();
     let whole_text = String::from_utf8(bytes(&whole, "results.jsonl")).unwrap();
     let lines: Vec<&str> = whole_text.lines().collect();
-    let mut text: String = [lines[7], lines[2], lines[9]].map(|l| format!("{l}\n")).concat();
+    let mut text: String = [lines[7], lines[2], lines[9]]
+        .map(|l| format!("{l}\n"))
+        .concat();
     text.push_str(&lines[0][..40]);
     std::fs::write(killed.join("results.jsonl"), text).unwrap();
     let r = run(
@@ -188,7 +198,11 @@ fn shards_merged_equal_the_whole_run() {
     for (name, def) in [("macro", macro_def(&f)), ("meso", meso_def(&f))] {
         let whole = tmp(&format!("{name}-whole"));
         let r = run(&f, &def, &whole, RunOptions::default());
-        assert!(r.summary.complete && r.cases >= 6, "{name}: {} cases", r.cases);
+        assert!(
+            r.summary.complete && r.cases >= 6,
+            "{name}: {} cases",
+            r.cases
+        );
         let shards: Vec<PathBuf> = (1..=2)
             .map(|k| {
                 let d = tmp(&format!("{name}-shard{k}"));
@@ -202,7 +216,10 @@ fn shards_merged_equal_the_whole_run() {
                         ..RunOptions::default()
                     },
                 );
-                assert!(!r.summary.complete, "{name}: a shard is not the whole study");
+                assert!(
+                    !r.summary.complete,
+                    "{name}: a shard is not the whole study"
+                );
                 assert!(r.shard_cases > 0 && r.shard_cases < r.cases);
                 d
             })
@@ -211,7 +228,10 @@ fn shards_merged_equal_the_whole_run() {
         let alone = tmp(&format!("{name}-alone"));
         let (_, s, _) = merge(&shards[..1], &alone).unwrap();
         assert!(!s.complete);
-        assert_ne!(bytes(&alone, "results.jsonl"), bytes(&whole, "results.jsonl"));
+        assert_ne!(
+            bytes(&alone, "results.jsonl"),
+            bytes(&whole, "results.jsonl")
+        );
         let merged = tmp(&format!("{name}-merged"));
         let (_, s, _) = merge(&[shards[1].clone(), shards[0].clone()], &merged).unwrap();
         assert!(s.complete);
@@ -300,7 +320,9 @@ fn bad_inputs_are_errors_naming_the_option() {
     .to_string();
     assert!(e.contains("another study") && e.contains("study.mu"), "{e}");
     let out = tmp("bad-out");
-    let e = merge(&[a.clone(), b.clone()], &out).unwrap_err().to_string();
+    let e = merge(&[a.clone(), b.clone()], &out)
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("bad-b") && e.contains("another study") && e.contains("study.mu"),
         "{e}"
@@ -309,7 +331,7 @@ fn bad_inputs_are_errors_naming_the_option() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("not a study directory"), "{e}");
-    let e = merge(&[a.clone()], &a).unwrap_err().to_string();
+    let e = merge(std::slice::from_ref(&a), &a).unwrap_err().to_string();
     assert!(e.starts_with("--out:"), "{e}");
     for d in [a, b, out] {
         let _ = std::fs::remove_dir_all(d);

@@ -17,11 +17,9 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 /// The paper's patch sides (m), `paper-data.toml` `[mesoscopic.coupling_2]` (2100 Hz).
-pub const PAPER_PATCHES_COUPLING_2: &str =
-    "0.0004,0.0006,0.0008,0.0010,0.0012,0.0014,0.0016";
+pub const PAPER_PATCHES_COUPLING_2: &str = "0.0004,0.0006,0.0008,0.0010,0.0012,0.0014,0.0016";
 /// The paper's patch sides (m), `paper-data.toml` `[mesoscopic.coupling_1]` (3500 Hz).
-pub const PAPER_PATCHES_COUPLING_1: &str =
-    "0.0005,0.0010,0.0015,0.0020,0.0025,0.0030,0.0035";
+pub const PAPER_PATCHES_COUPLING_1: &str = "0.0005,0.0010,0.0015,0.0020,0.0025,0.0030,0.0035";
 /// Region cut into patches for coupling 2 (m from the face corner): the paper gives no
 /// numbers, only "medium rectangular zones near the leading edge" (section 3.1): an
 /// 8 x 14 mm rectangle against the +x (leading) edge, centred radially.
@@ -103,9 +101,10 @@ pub struct MesoArgs<'a> {
 }
 
 fn solve_spec(o: &StudyOpts) -> Result<SolveSpec> {
-    let eigen = o.eigen.clone().unwrap_or_else(|| {
-        if o.basis == "none" { "arpack" } else { "dense" }.to_string()
-    });
+    let eigen = o
+        .eigen
+        .clone()
+        .unwrap_or_else(|| if o.basis == "none" { "arpack" } else { "dense" }.to_string());
     let s = SolveSpec {
         basis: o.basis.clone(),
         basis_params: o.basis_opt.clone(),
@@ -289,7 +288,10 @@ fn print_summary(s: &Summary) {
         );
     }
     if !s.by_patch.is_empty() {
-        println!("  {:>6} {:>9} {:>7} {:>10}  per class", "mu", "patch mm", "done", "unstable");
+        println!(
+            "  {:>6} {:>9} {:>7} {:>10}  per class",
+            "mu", "patch mm", "done", "unstable"
+        );
         for p in &s.by_patch {
             let classes: Vec<String> = p
                 .classes

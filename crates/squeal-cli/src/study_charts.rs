@@ -37,8 +37,9 @@ fn rect(r: &Record) -> Option<[f64; 4]> {
     }
 }
 
+/// A number for a file name: to 1e-6, `.` as `_` (`14.2` -> `14_2`).
 fn tag(v: f64) -> String {
-    format!("{v}").replace('.', "_")
+    format!("{}", (v * 1e6).round() / 1e6).replace('.', "_")
 }
 
 fn classes_label(def: &StudyDef, c: f64) -> String {
@@ -141,7 +142,11 @@ fn macro_charts(
                 }
             }
             panels.push(MapPanel {
-                title: format!("mu = {mu}, {}: {} zones", classes_label(def, c), zones.len()),
+                title: format!(
+                    "mu = {mu}, {}: {} zones",
+                    classes_label(def, c),
+                    zones.len()
+                ),
                 xy: def.grid.points_m.clone(),
                 values: cover,
                 cell: def.grid.spacing_m,
@@ -275,14 +280,29 @@ fn meso_charts(
                 .map(|m| (m.freq_hz, m.dvr))
                 .max_by(|a, b| a.1.total_cmp(&b.1))
         };
-        let mut trig: Vec<(&Record, (f64, f64))> =
-            recs.iter().filter_map(|r| dvr_of(r).map(|d| (*r, d))).collect();
+        let mut trig: Vec<(&Record, (f64, f64))> = recs
+            .iter()
+            .filter_map(|r| dvr_of(r).map(|d| (*r, d)))
+            .collect();
         if trig.is_empty() {
             continue;
         }
-        trig.sort_by(|a, b| b.1 .1.total_cmp(&a.1 .1).then(a.0.case.id.cmp(&b.0.case.id)));
-        let mut supp: Vec<&Record> = recs.iter().copied().filter(|r| dvr_of(r).is_none()).collect();
-        supp.sort_by(|a, b| b.case.pairs.cmp(&a.case.pairs).then(a.case.id.cmp(&b.case.id)));
+        trig.sort_by(|a, b| {
+            b.1 .1
+                .total_cmp(&a.1 .1)
+                .then(a.0.case.id.cmp(&b.0.case.id))
+        });
+        let mut supp: Vec<&Record> = recs
+            .iter()
+            .copied()
+            .filter(|r| dvr_of(r).is_none())
+            .collect();
+        supp.sort_by(|a, b| {
+            b.case
+                .pairs
+                .cmp(&a.case.pairs)
+                .then(a.case.id.cmp(&b.case.id))
+        });
         let name = |r: &Record| {
             format!(
                 "patch {:.2} mm #{}",
@@ -309,11 +329,16 @@ fn meso_charts(
             .take(2)
             .map(|(r, (f, d))| panel(r, format!("{}: {f:.0} Hz, DvR {d:.4}", name(r))))
             .collect();
-        panels.extend(
-            supp.iter()
-                .take(2)
-                .map(|r| panel(r, format!("{}: stable near {c:.0} Hz ({} pairs)", name(r), r.case.pairs))),
-        );
+        panels.extend(supp.iter().take(2).map(|r| {
+            panel(
+                r,
+                format!(
+                    "{}: stable near {c:.0} Hz ({} pairs)",
+                    name(r),
+                    r.case.pairs
+                ),
+            )
+        }));
         files.extend(contact_map(
             &dir.join(format!("layouts_{c:.0}hz")),
             &format!(

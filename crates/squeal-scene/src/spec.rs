@@ -266,9 +266,7 @@ impl Zone {
                 Zone::Plateaus { .. } => plateaus
                     .as_ref()
                     .is_some_and(|rs| rs.iter().any(|r| in_rect(p, r))),
-                Zone::Mask { values, .. } => {
-                    values.as_ref().is_some_and(|v| v.get(i) == Some(&1))
-                }
+                Zone::Mask { values, .. } => values.as_ref().is_some_and(|v| v.get(i) == Some(&1)),
             })
             .collect()
     }

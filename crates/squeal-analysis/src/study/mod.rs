@@ -118,12 +118,17 @@ pub fn parse_list(option: &str, text: &str) -> Result<Vec<f64>> {
                 if !(c > 0.0 && b >= a) {
                     return Err(input(
                         option,
-                        format!("range `{item}`: expected FROM:TO:STEP with FROM <= TO and STEP > 0"),
+                        format!(
+                            "range `{item}`: expected FROM:TO:STEP with FROM <= TO and STEP > 0"
+                        ),
                     ));
                 }
                 let n = ((b - a) / c + 1e-9).floor() as usize;
                 if n > 100_000 {
-                    return Err(input(option, format!("range `{item}` has {} values (at most 100001)", n + 1)));
+                    return Err(input(
+                        option,
+                        format!("range `{item}` has {} values (at most 100001)", n + 1),
+                    ));
                 }
                 out.extend((0..=n).map(|k| ((a + k as f64 * c) * 1e12).round() / 1e12));
             }
@@ -188,7 +193,9 @@ impl Shard {
         let bad = || {
             input(
                 "--shard",
-                format!("`{text}`: expected K/N with 1 <= K <= N (e.g. 2/8: the second of 8 parts)"),
+                format!(
+                    "`{text}`: expected K/N with 1 <= K <= N (e.g. 2/8: the second of 8 parts)"
+                ),
             )
         };
         let (k, n) = text.split_once('/').ok_or_else(bad)?;
@@ -292,21 +299,38 @@ impl SolveSpec {
     pub fn check(&self) -> Result<()> {
         let [lo, hi] = self.band_hz;
         if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo) {
-            return Err(input("--band", format!("expected 0 <= FMIN < FMAX (Hz), got {lo}:{hi}")));
+            return Err(input(
+                "--band",
+                format!("expected 0 <= FMIN < FMAX (Hz), got {lo}:{hi}"),
+            ));
         }
         if !(self.tol > 0.0 && self.tol < 1.0) {
-            return Err(input("--tol", format!("expected a tolerance in (0, 1), got {}", self.tol)));
+            return Err(input(
+                "--tol",
+                format!("expected a tolerance in (0, 1), got {}", self.tol),
+            ));
         }
         if !(self.dvr_tol.is_finite() && self.dvr_tol >= 0.0) {
-            return Err(input("--dvr-tol", format!("expected a DvR threshold >= 0, got {}", self.dvr_tol)));
+            return Err(input(
+                "--dvr-tol",
+                format!("expected a DvR threshold >= 0, got {}", self.dvr_tol),
+            ));
         }
-        if self.classes_hz.is_empty() || self.classes_hz.iter().any(|c| !(c.is_finite() && *c > 0.0)) {
-            return Err(input("--classes", format!("expected frequencies > 0 Hz, got {:?}", self.classes_hz)));
+        if self.classes_hz.is_empty()
+            || self.classes_hz.iter().any(|c| !(c.is_finite() && *c > 0.0))
+        {
+            return Err(input(
+                "--classes",
+                format!("expected frequencies > 0 Hz, got {:?}", self.classes_hz),
+            ));
         }
         if !(self.class_width > 0.0 && self.class_width < 1.0) {
             return Err(input(
                 "--class-width",
-                format!("expected a relative half-width in (0, 1), got {}", self.class_width),
+                format!(
+                    "expected a relative half-width in (0, 1), got {}",
+                    self.class_width
+                ),
             ));
         }
         Ok(())
@@ -334,8 +358,8 @@ impl SolveSpec {
     pub fn method(&self, registry: &Registry) -> Result<Method> {
         let mut params = Params::new();
         for kv in &self.basis_params {
-            let (k, v) = Params::parse_kv(kv)
-                .map_err(|e| input("--basis-opt", format!("`{kv}`: {e}")))?;
+            let (k, v) =
+                Params::parse_kv(kv).map_err(|e| input("--basis-opt", format!("`{kv}`: {e}")))?;
             params.0.insert(k, v);
         }
         Ok(Method::new(
@@ -485,7 +509,7 @@ fn positive(option: &str, v: &[f64], what: &str) -> Result<()> {
     if v.is_empty() {
         return Err(input(option, format!("expected at least one {what}")));
     }
-    if let Some(x) = v.iter().find(|x| !(**x > 0.0)) {
+    if let Some(x) = v.iter().find(|x| x.is_nan() || **x <= 0.0) {
         return Err(input(option, format!("expected {what}s > 0 m, got {x}")));
     }
     Ok(())
@@ -684,12 +708,18 @@ impl StudyDef {
                     ));
                 }
                 if s.layouts == 0 {
-                    return Err(input("--layouts", "expected at least one layout per patch size"));
+                    return Err(input(
+                        "--layouts",
+                        "expected at least one layout per patch size",
+                    ));
                 }
                 if !(s.fraction > 0.0 && s.fraction <= 1.0) {
                     return Err(input(
                         "--fraction",
-                        format!("expected a fraction of the patches in (0, 1], got {}", s.fraction),
+                        format!(
+                            "expected a fraction of the patches in (0, 1], got {}",
+                            s.fraction
+                        ),
                     ));
                 }
                 for &patch in &s.patch_m {

@@ -131,7 +131,6 @@ pub fn run_case(
     (rec, t)
 }
 
-
 /// The files of a study directory.
 pub struct StudyDir {
     /// The directory.
@@ -167,7 +166,8 @@ impl StudyDir {
     /// Reads `study.json`.
     pub fn read_def(&self) -> Result<StudyDef> {
         let p = self.study();
-        let text = std::fs::read_to_string(&p).map_err(|e| files(&p, format!("{e} (not a study directory?)")))?;
+        let text = std::fs::read_to_string(&p)
+            .map_err(|e| files(&p, format!("{e} (not a study directory?)")))?;
         serde_json::from_str(&text).map_err(|e| files(&p, e))
     }
 
@@ -322,7 +322,11 @@ pub fn run(
     if model.dofs.n_free() != def.dofs {
         return Err(input(
             "SCENE",
-            format!("the model has {} DOFs, the study {}", model.dofs.n_free(), def.dofs),
+            format!(
+                "the model has {} DOFs, the study {}",
+                model.dofs.n_free(),
+                def.dofs
+            ),
         ));
     }
     let list = def.cases()?;
@@ -453,7 +457,10 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<(StudyDef, Summary, Timin
                 if prev != &r {
                     return Err(files(
                         &sd.results(),
-                        format!("case {} differs from the one in another directory", r.case.id),
+                        format!(
+                            "case {} differs from the one in another directory",
+                            r.case.id
+                        ),
                     ));
                 }
             }
@@ -470,7 +477,10 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<(StudyDef, Summary, Timin
             .iter()
             .any(|i| i.canonicalize().ok().as_ref() == Some(&o))
     }) {
-        return Err(input("--out", "the merged directory must not be one of the inputs"));
+        return Err(input(
+            "--out",
+            "the merged directory must not be one of the inputs",
+        ));
     }
     std::fs::create_dir_all(out).map_err(|e| files(out, e))?;
     let text = serde_json::to_string_pretty(&want).map_err(|e| files(&od.study(), e))?;
@@ -496,7 +506,10 @@ fn finalize(
 ) -> Result<(Summary, TimingSummary)> {
     let ids: std::collections::BTreeSet<&str> = list.cases.iter().map(|c| c.id.as_str()).collect();
     let mut by_id: std::collections::BTreeMap<String, Record> = Default::default();
-    for r in records.into_iter().filter(|r| ids.contains(r.case.id.as_str())) {
+    for r in records
+        .into_iter()
+        .filter(|r| ids.contains(r.case.id.as_str()))
+    {
         by_id.insert(r.case.id.clone(), r);
     }
     let records: Vec<Record> = by_id.into_values().collect();

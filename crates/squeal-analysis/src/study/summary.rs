@@ -139,7 +139,9 @@ fn class_summaries(solve: &SolveSpec, records: &[&Record], with_zones: bool) -> 
                 .flat_map(|r| r.unstable.iter().filter(|m| m.class_hz == Some(c)))
                 .collect();
             let range = |v: &mut dyn Iterator<Item = f64>| -> [f64; 2] {
-                v.fold([f64::INFINITY, f64::NEG_INFINITY], |a, x| [a[0].min(x), a[1].max(x)])
+                v.fold([f64::INFINITY, f64::NEG_INFINITY], |a, x| {
+                    [a[0].min(x), a[1].max(x)]
+                })
             };
             let fix = |r: [f64; 2]| if r[0].is_finite() { r } else { [0.0, 0.0] };
             let areas: Vec<f64> = of.iter().map(|r| r.case.area_m2).collect();
@@ -228,7 +230,11 @@ pub fn summarize(def: &StudyDef, list: &CaseList, records: &[Record]) -> Summary
                     skipped_no_pairs: list.no_pairs_by_patch.get(pi).copied().unwrap_or(0),
                     done: rs.len(),
                     unstable: u,
-                    unstable_fraction: if rs.is_empty() { 0.0 } else { u as f64 / rs.len() as f64 },
+                    unstable_fraction: if rs.is_empty() {
+                        0.0
+                    } else {
+                        u as f64 / rs.len() as f64
+                    },
                     pairs: [
                         rs.iter().map(|r| r.case.pairs).min().unwrap_or(0),
                         rs.iter().map(|r| r.case.pairs).max().unwrap_or(0),
@@ -265,7 +271,10 @@ pub fn summarize(def: &StudyDef, list: &CaseList, records: &[Record]) -> Summary
         } else {
             n_unstable as f64 / records.len() as f64
         },
-        max_backward_error: records.iter().map(|r| r.max_backward_error).fold(0.0, f64::max),
+        max_backward_error: records
+            .iter()
+            .map(|r| r.max_backward_error)
+            .fold(0.0, f64::max),
         by_mu,
         by_patch,
         warnings: def.warnings(list),

@@ -87,7 +87,9 @@ fn lists_take_values_and_ranges_in_order() {
 
 #[test]
 fn bad_lists_name_the_option_and_the_form() {
-    for bad in ["", "0.1,", "x", "1:2", "2:1:0.5", "1:2:0", "1:2:-1", "1:2:3:4", "nan", "inf"] {
+    for bad in [
+        "", "0.1,", "x", "1:2", "2:1:0.5", "1:2:0", "1:2:-1", "1:2:3:4", "nan", "inf",
+    ] {
         let e = message(parse_list("--patch", bad).unwrap_err());
         assert!(e.starts_with("--patch: "), "{bad:?}: {e}");
     }
@@ -117,7 +119,11 @@ fn shards_split_every_case_exactly_once() {
             .map(|k| Shard::parse(&format!("{k}/{n}")).unwrap())
             .collect();
         for i in 0..37 {
-            assert_eq!(shards.iter().filter(|s| s.holds(i)).count(), 1, "{i} in {n}");
+            assert_eq!(
+                shards.iter().filter(|s| s.holds(i)).count(),
+                1,
+                "{i} in {n}"
+            );
         }
         // balanced: sizes differ by at most one
         let sizes: Vec<usize> = shards
@@ -129,7 +135,10 @@ fn shards_split_every_case_exactly_once() {
     assert_eq!(Shard::parse(" 2 / 3 ").unwrap(), Shard { k: 2, n: 3 });
     for bad in ["0/2", "3/2", "1/0", "2", "a/b", "1/2/3", "-1/2", ""] {
         let e = message(Shard::parse(bad).unwrap_err());
-        assert!(e.starts_with("--shard: ") && e.contains("K/N"), "{bad:?}: {e}");
+        assert!(
+            e.starts_with("--shard: ") && e.contains("K/N"),
+            "{bad:?}: {e}"
+        );
     }
 }
 
@@ -139,7 +148,12 @@ fn regions_need_four_values() {
         parse_region("--region", "0.01,0.003,0.008,0.014").unwrap(),
         [0.01, 0.003, 0.008, 0.014]
     );
-    for bad in ["0.01,0.003,0.008", "0,0,0,0.01", "-0.001,0,0.01,0.01", "a,b,c,d"] {
+    for bad in [
+        "0.01,0.003,0.008",
+        "0,0,0,0.01",
+        "-0.001,0,0.01,0.01",
+        "a,b,c,d",
+    ] {
         let e = message(parse_region("--region", bad).unwrap_err());
         assert!(e.starts_with("--region: "), "{bad:?}: {e}");
     }
@@ -163,7 +177,10 @@ fn seeds_are_stable_and_distinct() {
     let a = def(meso_spec(vec![0.001, 0.002])).cases().unwrap();
     let b = def(meso_spec(vec![0.002])).cases().unwrap();
     let zone = |l: &CaseList, id: &str| l.cases.iter().find(|c| c.id == id).unwrap().zone.clone();
-    assert_eq!(zone(&a, "mu03600-p002000-l00003"), zone(&b, "mu03600-p002000-l00003"));
+    assert_eq!(
+        zone(&a, "mu03600-p002000-l00003"),
+        zone(&b, "mu03600-p002000-l00003")
+    );
 }
 
 #[test]
@@ -218,14 +235,24 @@ fn zones_outside_the_face_are_errors_naming_the_option() {
     let e = message(cases(Axis::Values(vec![0.005]), vec![0.004, 0.018]).unwrap_err());
     assert!(e.starts_with("--a: ") && e.contains("<= 0.015"), "{e}");
     let e = message(
-        def(macro_spec(Axis::Centred, Axis::Values(vec![0.021]), vec![0.01], vec![0.001]))
-            .cases()
-            .unwrap_err(),
+        def(macro_spec(
+            Axis::Centred,
+            Axis::Values(vec![0.021]),
+            vec![0.01],
+            vec![0.001],
+        ))
+        .cases()
+        .unwrap_err(),
     );
     assert!(e.starts_with("--y0: "), "{e}");
     let e = message(cases(Axis::Centred, vec![0.0]).unwrap_err());
     assert!(e.starts_with("--a: ") && e.contains("> 0"), "{e}");
-    let mut d = def(macro_spec(Axis::Centred, Axis::Centred, vec![0.01], vec![0.01]));
+    let mut d = def(macro_spec(
+        Axis::Centred,
+        Axis::Centred,
+        vec![0.01],
+        vec![0.01],
+    ));
     if let StudySpec::Macro(s) = &mut d.study {
         s.mu = vec![-0.1];
     }
@@ -254,7 +281,11 @@ fn meso_cases_are_seeded_layouts_inside_the_region() {
         }
         assert_eq!(sel.iter().filter(|&&b| b).count(), c.pairs);
         // half of the patches: area = fraction of the region
-        assert!((c.area_m2 - 0.5 * 0.008 * 0.014).abs() < 1e-4 * c.area_m2, "{}", c.area_m2);
+        assert!(
+            (c.area_m2 - 0.5 * 0.008 * 0.014).abs() < 1e-4 * c.area_m2,
+            "{}",
+            c.area_m2
+        );
     }
     // layouts differ from one another
     assert_ne!(list.cases[0].zone, list.cases[1].zone);
@@ -264,11 +295,16 @@ fn meso_cases_are_seeded_layouts_inside_the_region() {
 fn bad_meso_inputs_name_the_option_and_the_expected_value() {
     let e = message(def(meso_spec(vec![0.0004])).cases().unwrap_err());
     assert!(
-        e.starts_with("--patch: ") && e.contains("contact grid spacing") && e.contains(">= 1.000 mm"),
+        e.starts_with("--patch: ")
+            && e.contains("contact grid spacing")
+            && e.contains(">= 1.000 mm"),
         "{e}"
     );
     let e = message(def(meso_spec(vec![0.009])).cases().unwrap_err());
-    assert!(e.starts_with("--patch: ") && e.contains("<= 0.008 m"), "{e}");
+    assert!(
+        e.starts_with("--patch: ") && e.contains("<= 0.008 m"),
+        "{e}"
+    );
     let mut d = def(meso_spec(vec![0.001]));
     if let StudySpec::Meso(s) = &mut d.study {
         s.region_m = [0.015, 0.0, 0.008, 0.01];
@@ -328,7 +364,12 @@ fn records_round_trip_through_a_json_line() {
 
 #[test]
 fn summaries_count_classes_per_group() {
-    let d = def(macro_spec(Axis::Centred, Axis::Centred, vec![0.004, 0.012], vec![0.0142]));
+    let d = def(macro_spec(
+        Axis::Centred,
+        Axis::Centred,
+        vec![0.004, 0.012],
+        vec![0.0142],
+    ));
     let list = d.cases().unwrap();
     let mode = |f: f64| UnstableMode {
         freq_hz: f,
@@ -339,7 +380,12 @@ fn summaries_count_classes_per_group() {
     let records: Vec<Record> = list
         .cases
         .iter()
-        .zip([vec![mode(2100.0)], vec![], vec![mode(3400.0), mode(7000.0)], vec![]])
+        .zip([
+            vec![mode(2100.0)],
+            vec![],
+            vec![mode(3400.0), mode(7000.0)],
+            vec![],
+        ])
         .map(|(c, unstable)| Record {
             case: c.clone(),
             basis_size: 10,
