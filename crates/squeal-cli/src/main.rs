@@ -325,7 +325,7 @@ enum SweepKind {
     Meso {
         /// Scene file (TOML) or embedded scene name; default: `pin-on-disc`.
         scene: Option<String>,
-        /// Which coupling's defaults: 2 (2100 Hz: region 0.010,0.003,0.008,0.014, patches
+        /// Which coupling's defaults: 2 (2100 Hz: region 0.010,0.003,0.010,0.014, patches
         /// 0.4-1.6 mm) or 1 (3500 Hz: region 0.003,0.003,0.014,0.014, patches 0.5-3.5 mm).
         #[arg(long, default_value_t = 2)]
         coupling: u8,

@@ -103,7 +103,7 @@ fn macro_charts(
                 files.extend(line_chart(
                     &dir.join(format!("{what}_vs_a_mu{}_b{}mm", tag(mu), tag(b * 1e3))),
                     &format!(
-                        "Modes vs zone length a (b = {:.1} mm, mu = {mu}, zone nearest the centre; unstable in red)",
+                        "Modes vs zone length a (b = {:.1} mm, mu = {mu}; unstable in red)",
                         b * 1e3
                     ),
                     "zone length a along sliding (mm)",
