@@ -3,12 +3,16 @@
 //! The analysis pipeline and its post-processing: the stability pipeline of a scene
 //! ([`pipeline`]: model, contact, equilibrium, operator, complex modes), normal modes of a
 //! built scene ([`modal`]), automatic mode labels ([`labels`]) and the paper's reference
-//! values ([`reference`](mod@reference)).
+//! values ([`reference`](mod@reference)), method benchmarks ([`bench`](mod@bench)),
+//! sweeps ([`sweep`]) and long studies over contact zones ([`study`]), with their
+//! JSON-lines records ([`jsonl`]).
 
 pub mod bench;
+pub mod jsonl;
 pub mod labels;
 pub mod modal;
 pub mod pipeline;
 pub mod reference;
+pub mod study;
 pub mod sweep;
 pub mod vtu;

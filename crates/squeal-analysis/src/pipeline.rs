@@ -320,6 +320,20 @@ pub struct Method {
     modal: Box<dyn EigenSolver>,
     params: EigenParams,
     cached: Option<squeal_core::reduction::ReducedOperator>,
+    last: StepTimes,
+}
+
+/// Where the time of the last [`Method::solve`] went (s); zero for stages it skipped.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StepTimes {
+    /// Building the basis (its real modes, static vectors, ...).
+    pub basis_s: f64,
+    /// Projecting the operator on the basis.
+    pub projection_s: f64,
+    /// The eigen solve (the reduced one with a basis, the full-order one without).
+    pub solve_s: f64,
+    /// Expanding the reduced modes and their backward errors on the full operator.
+    pub expansion_s: f64,
 }
 
 impl Method {
@@ -357,7 +371,13 @@ impl Method {
                 .map_err(core("modal eigen solver"))?,
             params,
             cached: None,
+            last: StepTimes::default(),
         })
+    }
+
+    /// Where the time of the last [`solve`](Self::solve) went.
+    pub fn last_times(&self) -> StepTimes {
+        self.last
     }
 
     /// The modes of `op` at `mu`; `rebuilt` says the operator changed since the last call
@@ -369,12 +389,17 @@ impl Method {
                 .eigen
                 .solve_frictional(op, mu, &self.params)
                 .map_err(core(&format!("`{}` at mu = {mu}", self.eigen_name)))?;
+            self.last = StepTimes {
+                solve_s: modes.info.time_s,
+                ..StepTimes::default()
+            };
             return Ok((modes, 0, 0.0));
         };
         let stale = rebuilt
             || self.cached.is_none()
             || (basis.depends_on_mu() && self.cached.as_ref().and_then(|c| c.basis.mu) != Some(mu));
         let mut setup = 0.0;
+        self.last = StepTimes::default();
         if stale {
             let t = Instant::now();
             let req = squeal_core::contact::BasisRequest {
@@ -393,6 +418,9 @@ impl Method {
                     .map_err(core("projection on the basis"))?,
             );
             setup = t.elapsed().as_secs_f64();
+            let projection_s = self.cached.as_ref().map_or(0.0, |c| c.projection_time_s);
+            self.last.projection_s = projection_s;
+            self.last.basis_s = setup - projection_s;
         }
         let red = self
             .cached
@@ -400,6 +428,8 @@ impl Method {
             .expect("basis built")
             .solve(op, mu, self.eigen.as_ref(), &self.params)
             .map_err(core(&format!("reduced solve at mu = {mu}")))?;
+        self.last.solve_s = red.solve_time_s;
+        self.last.expansion_s = red.expansion_time_s;
         Ok((red.modes, red.basis_size, setup))
     }
 }

@@ -265,26 +265,12 @@ impl Checkpoint {
     /// Points already computed (a truncated last line, from a crash mid-write, is
     /// ignored).
     pub fn load(&self) -> std::io::Result<Vec<SweepPoint>> {
-        match std::fs::read_to_string(&self.path) {
-            Ok(text) => Ok(text
-                .lines()
-                .filter_map(|l| serde_json::from_str::<SweepPoint>(l).ok())
-                .collect()),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Vec::new()),
-            Err(e) => Err(e),
-        }
+        crate::jsonl::load(&self.path)
     }
 
     /// Appends one point (flushed before returning).
     pub fn append(&self, point: &SweepPoint) -> std::io::Result<()> {
-        use std::io::Write;
-        let mut f = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(&self.path)?;
-        let line = serde_json::to_string(point).map_err(std::io::Error::other)?;
-        writeln!(f, "{line}")?;
-        f.sync_data()
+        crate::jsonl::append(&self.path, point)
     }
 }
 

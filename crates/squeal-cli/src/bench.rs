@@ -231,6 +231,9 @@ fn case_operator(
 }
 
 /// Runs the bench (or the stress set) and writes its outputs.
+/// A benchmark case: name, description, mu, zone, one varied basis parameter.
+type BenchCase<'a> = (String, String, f64, Option<Zone>, Option<(&'a str, f64)>);
+
 pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -> Result<()> {
     let start = Instant::now();
     std::fs::create_dir_all(a.out).with_context(|| format!("creating {}", a.out.display()))?;
@@ -262,7 +265,7 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
     for &mu in a.mus {
         squeal_contact::check_user_mu(mu)?;
     }
-    let cases: Vec<(String, String, f64, Option<Zone>, Option<(&str, f64)>)> = if a.stress {
+    let cases: Vec<BenchCase<'_>> = if a.stress {
         stress_cases()
             .into_iter()
             .map(|c| (c.name.to_string(), c.what.to_string(), c.mu, c.zone, c.vary))

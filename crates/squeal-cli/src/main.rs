@@ -5,6 +5,8 @@ mod equilibrium;
 mod modes;
 mod scene_cmd;
 mod stability;
+mod study;
+mod study_charts;
 mod sweep;
 mod validate;
 
@@ -223,6 +225,19 @@ enum Command {
         #[command(subcommand)]
         kind: SweepKind,
     },
+    /// Joins the directories of a study's shards (`--shard K/N` runs) into one: the same
+    /// results.jsonl and summary.json as one run over the whole study, plus its charts.
+    Merge {
+        /// Study directories (the --out of each shard).
+        #[arg(required = true)]
+        dirs: Vec<std::path::PathBuf>,
+        /// Merged directory (must not be one of the inputs).
+        #[arg(long)]
+        out: std::path::PathBuf,
+        /// Skip the charts.
+        #[arg(long)]
+        no_charts: bool,
+    },
     /// Lists the registered plugins.
     Plugins,
     /// Scene inspection.
@@ -270,6 +285,72 @@ enum SweepKind {
         dvr_tol: f64,
         /// Output directory.
         #[arg(long, default_value = "out/sweep-mu")]
+        out: std::path::PathBuf,
+    },
+    /// Macroscopic effective zones (paper section 3.1): every rectangle (x0, y0, a, b) of
+    /// the grid of lists, all its pairs closed and sliding, at each mu. Lists are
+    /// comma-separated values and FROM:TO:STEP ranges, in m from the pin face's corner
+    /// (x along sliding, y radial). Writes study.json, results.jsonl, summary.json,
+    /// timings.jsonl, timings.json and charts; resumable (--resume), shardable (--shard).
+    Macro {
+        /// Scene file (TOML) or embedded scene name; default: `pin-on-disc`.
+        scene: Option<String>,
+        /// Zone starts along x (m), or `centred`.
+        #[arg(long, default_value = "centred")]
+        x0: String,
+        /// Zone starts along y (m), or `centred`.
+        #[arg(long, default_value = "centred")]
+        y0: String,
+        /// Zone lengths along x, the sliding direction (m).
+        #[arg(long, default_value = "0.004:0.02:0.002")]
+        a: String,
+        /// Zone widths along y (m); the paper's Figure 12 uses 14.2 mm.
+        #[arg(long, default_value = "0.0142")]
+        b: String,
+        /// Friction coefficients (the paper's 0.36 and 0.43).
+        #[arg(long, default_value = "0.36,0.43")]
+        mu: String,
+        #[command(flatten)]
+        opts: study::StudyOpts,
+        /// Output directory.
+        #[arg(long, default_value = "out/sweep-macro")]
+        out: std::path::PathBuf,
+    },
+    /// Mesoscopic plateaus (paper section 3.2): a fixed region of the pin face cut into
+    /// square patches, seeded random subsets of them in contact (all their pairs closed
+    /// and sliding), --layouts per patch size. Defaults: the paper's patch sizes and mu
+    /// for --coupling 2 (2100 Hz) or 1 (3500 Hz); those patches need a contact grid of
+    /// 0.2 mm (mesh.pin_face_elements = 100): on the default scene (1 mm) give --patch.
+    /// Same outputs, resume and shards as `sweep macro`.
+    Meso {
+        /// Scene file (TOML) or embedded scene name; default: `pin-on-disc`.
+        scene: Option<String>,
+        /// Which coupling's defaults: 2 (2100 Hz: region 0.010,0.003,0.010,0.014, patches
+        /// 0.4-1.6 mm) or 1 (3500 Hz: region 0.003,0.003,0.014,0.014, patches 0.5-3.5 mm).
+        #[arg(long, default_value_t = 2)]
+        coupling: u8,
+        /// Region cut into patches, `x0,y0,a,b` (m from the pin face's corner).
+        #[arg(long)]
+        region: Option<String>,
+        /// Patch sides (m), a list.
+        #[arg(long)]
+        patch: Option<String>,
+        /// Random layouts per patch size.
+        #[arg(long, default_value_t = 200)]
+        layouts: usize,
+        /// Fraction of the patches in contact in each layout, in (0, 1].
+        #[arg(long, default_value_t = 0.5)]
+        fraction: f64,
+        /// Base seed of the layouts.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Friction coefficients.
+        #[arg(long, default_value = "0.36")]
+        mu: String,
+        #[command(flatten)]
+        opts: study::StudyOpts,
+        /// Output directory.
+        #[arg(long, default_value = "out/sweep-meso")]
         out: std::path::PathBuf,
     },
 }
@@ -649,6 +730,68 @@ fn run() -> Result<()> {
                 },
                 Some(&probe),
             )?;
+        }
+        Command::Sweep {
+            kind:
+                SweepKind::Macro {
+                    scene,
+                    x0,
+                    y0,
+                    a,
+                    b,
+                    mu,
+                    opts,
+                    out,
+                },
+        } => study::run_macro(
+            &registry,
+            &study::MacroArgs {
+                scene: scene.as_deref(),
+                x0: &x0,
+                y0: &y0,
+                a: &a,
+                b: &b,
+                mu: &mu,
+                out: &out,
+                opts: &opts,
+            },
+        )?,
+        Command::Sweep {
+            kind:
+                SweepKind::Meso {
+                    scene,
+                    coupling,
+                    region,
+                    patch,
+                    layouts,
+                    fraction,
+                    seed,
+                    mu,
+                    opts,
+                    out,
+                },
+        } => study::run_meso(
+            &registry,
+            &study::MesoArgs {
+                scene: scene.as_deref(),
+                coupling,
+                region: region.as_deref(),
+                patch: patch.as_deref(),
+                layouts,
+                fraction,
+                seed,
+                mu: &mu,
+                out: &out,
+                opts: &opts,
+            },
+        )?,
+        Command::Merge {
+            dirs,
+            out,
+            no_charts,
+        } => {
+            study::check_dirs(&dirs)?;
+            study::merge(&dirs, &out, no_charts)?;
         }
         Command::Plugins => {
             for (kind, list) in [

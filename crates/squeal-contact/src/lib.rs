@@ -48,6 +48,18 @@ pub enum ContactError {
 /// Result with [`ContactError`].
 pub type Result<T> = std::result::Result<T, ContactError>;
 
+/// The pairs of a contact grid relative to the pin face's corner (m, grid order) and the
+/// face size `[size_x, size_y]` (m): the coordinates zones are given in.
+pub fn face_points(grid: &squeal_scene::ContactGrid) -> (Vec<[f64; 2]>, [f64; 2]) {
+    let (x_lo, y_lo) = (grid.xs[0], grid.ys[0]);
+    let size = [
+        grid.xs[grid.xs.len() - 1] - x_lo,
+        grid.ys[grid.ys.len() - 1] - y_lo,
+    ];
+    let rel = grid.xy.iter().map(|p| [p[0] - x_lo, p[1] - y_lo]).collect();
+    (rel, size)
+}
+
 /// Candidate contact pairs with their kinematics, on the model's free DOFs.
 #[derive(Debug, Clone)]
 pub struct ContactSet {
@@ -86,17 +98,7 @@ impl ContactSet {
                 message: format!("expected 1 or -1, got {rotation}"),
             });
         }
-        let (x_lo, y_lo) = (grid.xs[0], grid.ys[0]);
-        let size = [
-            grid.xs[grid.xs.len() - 1] - x_lo,
-            grid.ys[grid.ys.len() - 1] - y_lo,
-        ];
-        let in_rect = |p: usize, r: &[f64; 4]| -> bool {
-            let (x, y) = (grid.xy[p][0] - x_lo, grid.xy[p][1] - y_lo);
-            let eps = 1e-9 * (size[0] + size[1]);
-            x >= r[0] - eps && x <= r[0] + r[2] + eps && y >= r[1] - eps && y <= r[1] + r[3] + eps
-        };
-        let plateaus = zone.plateau_rectangles(size);
+        let (rel, size) = face_points(grid);
         if let Zone::Mask {
             values: Some(v), ..
         } = zone
@@ -108,21 +110,8 @@ impl ContactSet {
                 });
             }
         }
-        let inside = |p: usize| -> bool {
-            match zone {
-                Zone::Uniform => true,
-                Zone::Rectangle {
-                    x0_m,
-                    y0_m,
-                    a_m,
-                    b_m,
-                } => in_rect(p, &[*x0_m, *y0_m, *a_m, *b_m]),
-                Zone::Plateaus { .. } => plateaus
-                    .as_ref()
-                    .is_some_and(|rs| rs.iter().any(|r| in_rect(p, r))),
-                Zone::Mask { values, .. } => values.as_ref().is_some_and(|v| v[p] == 1),
-            }
-        };
+        let selected = zone.select(&rel, size);
+        let inside = |p: usize| -> bool { selected[p] };
         let dof = |node: usize, what: &str| -> Result<[usize; 3]> {
             let mut d = [0; 3];
             for (a, slot) in d.iter_mut().enumerate() {

@@ -240,6 +240,37 @@ pub enum Zone {
 }
 
 impl Zone {
+    /// Which of the points `xy` (m, relative to the pin face's corner, in grid order) lie
+    /// in the zone on a face of `size = [size_x, size_y]`: rectangles and plateaus include
+    /// their edges (to `1e-9` of the face size); a mask selects by index (`values[p] == 1`;
+    /// the caller checks its length). The one inside test of contact sets, studies and maps.
+    pub fn select(&self, xy: &[[f64; 2]], size: [f64; 2]) -> Vec<bool> {
+        let eps = 1e-9 * (size[0] + size[1]);
+        let in_rect = |p: &[f64; 2], r: &[f64; 4]| -> bool {
+            p[0] >= r[0] - eps
+                && p[0] <= r[0] + r[2] + eps
+                && p[1] >= r[1] - eps
+                && p[1] <= r[1] + r[3] + eps
+        };
+        let plateaus = self.plateau_rectangles(size);
+        xy.iter()
+            .enumerate()
+            .map(|(i, p)| match self {
+                Zone::Uniform => true,
+                Zone::Rectangle {
+                    x0_m,
+                    y0_m,
+                    a_m,
+                    b_m,
+                } => in_rect(p, &[*x0_m, *y0_m, *a_m, *b_m]),
+                Zone::Plateaus { .. } => plateaus
+                    .as_ref()
+                    .is_some_and(|rs| rs.iter().any(|r| in_rect(p, r))),
+                Zone::Mask { values, .. } => values.as_ref().is_some_and(|v| v.get(i) == Some(&1)),
+            })
+            .collect()
+    }
+
     /// The rectangles `[x0, y0, a, b]` (m, from the pin face's corner) of a plateau
     /// layout on a face of `size = [size_x, size_y]`; `None` for other zones.
     pub fn plateau_rectangles(&self, size: [f64; 2]) -> Option<Vec<[f64; 4]>> {
