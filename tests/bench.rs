@@ -128,3 +128,58 @@ fn the_comparison_counts_missed_false_and_shifted_modes() {
     assert_eq!(e.missed_modes, 0);
     assert!((e.max_rel_freq_err - 0.005).abs() < 1e-9, "{e:?}");
 }
+
+#[test]
+fn bench_json_round_trips_failed_runs() {
+    // a basis whose build always fails: a failed run with unmeasured (NaN) errors next
+    // to the successful `modes` one
+    struct Failing;
+    impl squeal::core::ReductionBasis for Failing {
+        fn name(&self) -> &str {
+            "failing"
+        }
+        fn build(
+            &self,
+            _: &squeal::core::BasisRequest<'_>,
+        ) -> squeal::core::Result<squeal::core::Basis> {
+            Err(squeal::core::Error::Invalid(
+                "this basis always fails".into(),
+            ))
+        }
+    }
+    let mut reg = squeal::registry();
+    reg.bases.register("failing", "always fails", |_: &Params| {
+        let b: Box<dyn squeal::core::ReductionBasis> = Box::new(Failing);
+        Ok(b)
+    });
+    let mu = 0.3;
+    let op = coarse_operator(&reg, mu);
+    let mut opts = BenchOptions::all(&reg);
+    opts.band_hz = [0.0, 4000.0];
+    opts.bases = vec!["modes".into(), "failing".into()];
+    opts.eigens = vec!["dense".into()];
+    opts.vary = Vec::new();
+    let (_, runs) = bench_case(&reg, "mu=0.3", &op, mu, &opts, None, |_| {}).unwrap();
+    let failed = runs
+        .iter()
+        .find(|r| r.basis == "failing")
+        .expect("the failing run");
+    assert!(
+        failed.status.contains("this basis always fails"),
+        "{}",
+        failed.status
+    );
+    assert!(failed.status.starts_with("error"), "{}", failed.status);
+    assert!(failed.errors.max_rel_freq_err.is_nan());
+    assert!(failed.speedup.is_nan(), "a failed run has no speed-up");
+    assert!(runs.iter().any(|r| r.status == "ok" && !r.reference));
+    let text = serde_json::to_string(&runs).unwrap();
+    assert!(text.contains("null"), "NaN is written as null");
+    let back: Vec<squeal::analysis::bench::BenchRun> = serde_json::from_str(&text).unwrap();
+    assert_eq!(back.len(), runs.len());
+    for (a, b) in runs.iter().zip(&back) {
+        assert_eq!(a.status, b.status);
+        let (x, y) = (a.errors.max_rel_freq_err, b.errors.max_rel_freq_err);
+        assert!(x == y || (x.is_nan() && y.is_nan()), "{x} vs {y}");
+    }
+}

@@ -115,8 +115,10 @@ pub struct ModeErrors {
     /// Modes in the band matched to no reference mode.
     pub extra_modes: usize,
     /// Largest relative frequency error over matched modes (NaN when none matched).
+    #[serde(deserialize_with = "null_as_nan")]
     pub max_rel_freq_err: f64,
     /// Largest absolute DvR error over matched modes.
+    #[serde(deserialize_with = "null_as_nan")]
     pub max_abs_dvr_err: f64,
     /// Unstable reference modes.
     pub reference_unstable: usize,
@@ -125,6 +127,7 @@ pub struct ModeErrors {
     /// Unstable modes in the band whose partner is stable, or without partner.
     pub false_unstable: usize,
     /// Worst backward error (on the full operator) of the modes in the band.
+    #[serde(deserialize_with = "null_as_nan")]
     pub max_backward_error: f64,
 }
 
@@ -222,6 +225,11 @@ pub fn compare(
     e
 }
 
+/// JSON writes NaN (an error that could not be measured) as `null`; read it back as NaN.
+fn null_as_nan<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    Option::<f64>::deserialize(d).map(|v| v.unwrap_or(f64::NAN))
+}
+
 /// One benchmark run: one (basis, parameters, eigen solver) on one operator at one mu.
 /// The keys of `bench.json`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -266,8 +274,10 @@ pub struct BenchRun {
     /// Whether the errors meet the accuracy bounds of the bench.
     pub accurate: bool,
     /// Reference time / `time_s`.
+    #[serde(deserialize_with = "null_as_nan")]
     pub speedup: f64,
     /// Reference time / `solve_s` (the per-mu speed-up of a basis reused across mu).
+    #[serde(deserialize_with = "null_as_nan")]
     pub solve_speedup: f64,
 }
 
@@ -293,6 +303,7 @@ pub struct ReferenceSolve {
     /// Unstable modes `[freq_hz, dvr]`.
     pub unstable: Vec<[f64; 2]>,
     /// Worst backward error in the band.
+    #[serde(deserialize_with = "null_as_nan")]
     pub max_backward_error: f64,
 }
 
@@ -399,8 +410,10 @@ pub fn bench_case(
     let mut push = |mut run: BenchRun, runs: &mut Vec<BenchRun>| {
         run.time_s = run.setup_s + run.solve_s;
         run.accurate = run.status == "ok" && run.errors.accurate(&opts.accuracy);
-        run.speedup = ref_time / run.time_s;
-        run.solve_speedup = ref_time / run.solve_s;
+        // A failed run has no speed-up (its time is that of the failure).
+        let ok = run.status == "ok";
+        run.speedup = if ok { ref_time / run.time_s } else { f64::NAN };
+        run.solve_speedup = if ok { ref_time / run.solve_s } else { f64::NAN };
         on_run(&run);
         runs.push(run);
     };
@@ -545,8 +558,10 @@ pub struct SpeedRatio {
     /// Parameters of the fastest accurate run.
     pub basis_opts: String,
     /// Reference time / time of that run (setup included).
+    #[serde(deserialize_with = "null_as_nan")]
     pub speedup: f64,
     /// Reference time / its per-mu solve time.
+    #[serde(deserialize_with = "null_as_nan")]
     pub solve_speedup: f64,
 }
 

@@ -230,6 +230,23 @@ fn case_operator(
     ))
 }
 
+/// Redraws the charts (or the stress table) of a finished run from its `bench.json`
+/// (`stress.json`) in `out`.
+pub fn replot(out: &Path, stress: bool) -> Result<()> {
+    let json = out.join(if stress { "stress.json" } else { "bench.json" });
+    let text = std::fs::read_to_string(&json)
+        .with_context(|| format!("--replot: reading {} (run the bench first)", json.display()))?;
+    let runs: Vec<BenchRun> = serde_json::from_str(&text)
+        .with_context(|| format!("--replot: {} is not a list of bench runs", json.display()))?;
+    let files = if stress {
+        stress_report(out, &runs)?
+    } else {
+        charts(out, &runs)?
+    };
+    println!("redrew {} files in {}", files.len(), out.display());
+    Ok(())
+}
+
 /// Runs the bench (or the stress set) and writes its outputs.
 /// A benchmark case: name, description, mu, zone, one varied basis parameter.
 type BenchCase<'a> = (String, String, f64, Option<Zone>, Option<(&'a str, f64)>);
@@ -377,11 +394,48 @@ fn label(r: &BenchRun) -> String {
     if r.basis_opts.is_empty() {
         format!("{}/{}", r.basis, r.eigen)
     } else {
-        format!("{}/{} {}", r.basis, r.eigen, r.basis_opts)
+        format!("{} [{}]/{}", r.basis, r.basis_opts, r.eigen)
     }
 }
 
-/// Error vs time (Pareto front marked) and error vs basis size, per case.
+/// Chart points `(label, time, error)`: the runs of one basis variant whose errors agree
+/// to 1 % (the eigen solvers of one reduced problem do, to a few digits) become one point
+/// at the fastest time, labelled `basis [opts]/fastest (~ others)`, so labels do not
+/// overlap on the log axes.
+fn merged_points(
+    runs: &[&BenchRun],
+    err: fn(&BenchRun) -> f64,
+    time: fn(&BenchRun) -> f64,
+) -> Vec<(String, f64, f64)> {
+    let mut groups: Vec<Vec<&BenchRun>> = Vec::new();
+    for r in runs.iter().filter(|r| err(r).is_finite()) {
+        let same = |g: &Vec<&BenchRun>| {
+            let h = g[0];
+            h.basis == r.basis
+                && h.basis_opts == r.basis_opts
+                && (err(h) - err(r)).abs() <= 1e-2 * err(h).abs().max(err(r).abs())
+        };
+        match groups.iter_mut().find(|g| same(g)) {
+            Some(g) => g.push(r),
+            None => groups.push(vec![r]),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|mut g| {
+            g.sort_by(|a, b| time(a).total_cmp(&time(b)));
+            let mut name = label(g[0]);
+            if g.len() > 1 {
+                let others: Vec<&str> = g[1..].iter().map(|r| r.eigen.as_str()).collect();
+                name.push_str(&format!(" (~ {})", others.join(", ")));
+            }
+            (name, time(g[0]), err(g[0]))
+        })
+        .collect()
+}
+
+/// Error vs time (total, and per mu with the basis reused; Pareto front marked) and
+/// error vs basis size, per case.
 fn charts(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     let mut cases: Vec<&str> = runs.iter().map(|r| r.case.as_str()).collect();
@@ -392,6 +446,10 @@ fn charts(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
             .filter(|r| r.case == case && r.status == "ok" && !r.reference)
             .collect();
         let tag = case.replace('=', "");
+        let ref_time = runs
+            .iter()
+            .find(|r| r.case == case && r.reference)
+            .map_or(f64::NAN, |r| r.solve_s);
         for (what, key, err) in [
             (
                 "max relative frequency error",
@@ -402,19 +460,30 @@ fn charts(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
                 r.errors.max_abs_dvr_err
             }),
         ] {
-            let pts: Vec<(String, f64, f64)> = ok
-                .iter()
-                .filter(|r| err(r).is_finite())
-                .map(|r| (label(r), r.time_s, err(r)))
-                .collect();
-            if pts.iter().any(|p| p.1 > 0.0 && p.2 > 0.0) {
-                files.extend(pareto_chart(
-                    &out.join(format!("{key}_error_vs_time_{tag}")),
-                    &format!("{case}: {what} vs time (setup + solve) against the reference"),
-                    "time (s)",
-                    what,
-                    &pts,
-                )?);
+            for (stem, stem_title, axis, time) in [
+                (
+                    "time",
+                    "total time",
+                    "time (setup + solve)",
+                    (|r: &BenchRun| r.time_s) as fn(&BenchRun) -> f64,
+                ),
+                (
+                    "solve_time",
+                    "per-mu time",
+                    "per-mu solve time, basis reused",
+                    |r: &BenchRun| r.solve_s,
+                ),
+            ] {
+                let pts = merged_points(&ok, err, time);
+                if pts.iter().any(|p| p.1 > 0.0 && p.2 > 0.0) {
+                    files.extend(pareto_chart(
+                        &out.join(format!("{key}_error_vs_{stem}_{tag}")),
+                        &format!("{case}: {what} vs {stem_title} (reference {ref_time:.1} s)"),
+                        &format!("{axis} (s)"),
+                        what,
+                        &pts,
+                    )?);
+                }
             }
         }
         // error vs basis size, one series per basis/eigen

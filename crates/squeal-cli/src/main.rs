@@ -210,6 +210,10 @@ enum Command {
         /// Run the stress set (cases built to break methods) instead of the mu list.
         #[arg(long)]
         stress: bool,
+        /// Only redraw the charts (and the stress table) from the `bench.json` or
+        /// `stress.json` already in `--out`, without solving anything.
+        #[arg(long)]
+        replot: bool,
         /// Equilibrium solver plugin.
         #[arg(long, default_value = "lcp")]
         equilibrium: String,
@@ -682,10 +686,14 @@ fn run() -> Result<()> {
             reference,
             reference_tol,
             stress,
+            replot,
             equilibrium,
             law,
             out,
         } => {
+            if replot {
+                return bench::replot(&out, stress);
+            }
             let mut opts = squeal_analysis::bench::BenchOptions::all(&registry);
             if !bases.is_empty() {
                 opts.bases = bases;
