@@ -29,8 +29,8 @@
 //! `V^T X V` for each part `X` in {`M_c`, `C_c`, `K_c`, `F_M`, `F_C`, `F_K`} (the friction
 //! parts have `4 nA` nonzero rows, so their projection is cheap), a dense-backed
 //! [`FrictionalOperator`] with `t: None`, solved by any [`EigenSolver`] (normally `dense`)
-//! at each mu; the modes `u_c = V q` are finished by [`finish_modes`] on `op.at(mu)`, so
-//! their backward errors are those of the full problem.
+//! at each mu; the modes `u_c = V q` are finished by [`finish_operator_modes`] on the
+//! parts of `op.at(mu)`, so their backward errors are those of the full problem.
 
 use crate::contact::{Basis, BasisRequest, FrictionalOperator};
 use crate::eigen::{EigenParams, EigenSolver, RealModes, SymmetricProblem};
