@@ -1140,19 +1140,7 @@ pub fn dense_qep(qep: &Qep) -> Result<(Vec<c64>, Mat<c64>)> {
             a[(n + i, j)] = -w[(i, j)];
         }
     }
-    if (0..2 * n).any(|j| (0..2 * n).any(|i| !a[(i, j)].is_finite())) {
-        return Err(Error::Factorization {
-            what: format!("M~ (dense, n = {n})"),
-            reason: "M~^-1 [K~ C~] is not finite: the mass matrix is numerically singular".into(),
-        });
-    }
-    let eig = faer::linalg::solvers::Eigen::new_from_real(a.as_ref()).map_err(|e| {
-        Error::NotConverged {
-            method: "dense non-symmetric eigen (companion form)".into(),
-            iterations: 0,
-            detail: format!("{e:?}"),
-        }
-    })?;
+    let eig = dense_eigen(a.as_ref(), n, "M~^-1 [K~ C~]", "companion form")?;
     let s = eig.S();
     let z = eig.U();
     let mut lambda = Vec::with_capacity(2 * n);
@@ -1187,24 +1175,33 @@ pub fn dense_qep(qep: &Qep) -> Result<(Vec<c64>, Mat<c64>)> {
     Ok((lambda, vectors))
 }
 
+/// Eigen decomposition of the dense matrix `a` (`what`, built from `M~^-1` of a QEP of
+/// size `n`; `form` names it in errors), refused when it is not finite (singular mass).
+fn dense_eigen(
+    a: MatRef<'_, f64>,
+    n: usize,
+    what: &str,
+    form: &str,
+) -> Result<faer::linalg::solvers::Eigen<f64>> {
+    if (0..a.ncols()).any(|j| (0..a.nrows()).any(|i| !a[(i, j)].is_finite())) {
+        return Err(Error::Factorization {
+            what: format!("M~ (dense, n = {n})"),
+            reason: format!("{what} is not finite: the mass matrix is numerically singular"),
+        });
+    }
+    faer::linalg::solvers::Eigen::new_from_real(a).map_err(|e| Error::NotConverged {
+        method: format!("dense non-symmetric eigen ({form})"),
+        iterations: 0,
+        detail: format!("{e:?}"),
+    })
+}
+
 /// The undamped branch of [`dense_qep`]: with `C = 0`, `mu^2 = -t` for the eigenvalues
 /// `t` of `W = M_s^-1 K_s` (`n x n`, against `2n x 2n` for the companion form: 8 times
 /// fewer flops), each `t` giving the two roots `mu = +-sqrt(-t)` with the same vector.
 fn dense_qep_squared(w: Mat<f64>, gamma: f64) -> Result<(Vec<c64>, Mat<c64>)> {
     let n = w.nrows();
-    if (0..n).any(|j| (0..n).any(|i| !w[(i, j)].is_finite())) {
-        return Err(Error::Factorization {
-            what: format!("M~ (dense, n = {n})"),
-            reason: "M~^-1 K~ is not finite: the mass matrix is numerically singular".into(),
-        });
-    }
-    let eig = faer::linalg::solvers::Eigen::new_from_real(w.as_ref()).map_err(|e| {
-        Error::NotConverged {
-            method: "dense non-symmetric eigen (M~^-1 K~, C = 0)".into(),
-            iterations: 0,
-            detail: format!("{e:?}"),
-        }
-    })?;
+    let eig = dense_eigen(w.as_ref(), n, "M~^-1 K~", "M~^-1 K~, C = 0")?;
     let t = eig.S();
     let z = eig.U();
     let mut lambda = Vec::with_capacity(2 * n);

@@ -3,6 +3,21 @@ use crate::eigen::EigenParams;
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
 
+/// A blank [`SolveInfo`] of solver `solver`.
+fn info(solver: &str) -> SolveInfo {
+    SolveInfo {
+        solver: solver.into(),
+        time_s: 0.0,
+        requested: 0,
+        converged: 0,
+        iterations: 0,
+        op_applications: 0,
+        factorizations: 0,
+        reason: StopReason::Converged,
+        notes: vec![],
+    }
+}
+
 fn c(re: f64, im: f64) -> c64 {
     c64::new(re, im)
 }
@@ -390,24 +405,7 @@ fn dense_qep_rigid_body_root_is_zero_and_dropped() {
             2
         };
         assert_eq!(zeros, want_zeros, "{damping:?}: {lam:?}");
-        let modes = finish_modes(
-            &qep,
-            &lam,
-            u.as_ref(),
-            &params,
-            SolveInfo {
-                solver: "test".into(),
-                time_s: 0.0,
-                requested: 0,
-                converged: 0,
-                iterations: 0,
-                op_applications: 0,
-                factorizations: 0,
-                reason: StopReason::Converged,
-                notes: vec![],
-            },
-        )
-        .unwrap();
+        let modes = finish_modes(&qep, &lam, u.as_ref(), &params, info("test")).unwrap();
         assert_eq!(modes.len(), 2, "{damping:?}: {:?}", modes.lambda);
         for (i, w2) in [1.0f64, 3.0].iter().enumerate() {
             // |lambda|^2 = omega^2 for Rayleigh and mass damping alike.
@@ -534,17 +532,7 @@ fn band_driver_finds_every_mode_of_a_chain() {
         ..Default::default()
     };
     let (lam, u) = dense_qep(&qep).unwrap();
-    let info = SolveInfo {
-        solver: "dense".into(),
-        time_s: 0.0,
-        requested: 0,
-        converged: 0,
-        iterations: 0,
-        op_applications: 0,
-        factorizations: 0,
-        reason: StopReason::Converged,
-        notes: vec![],
-    };
+    let info = info("dense");
     let reference = finish_modes(&qep, &lam, u.as_ref(), &params, info).unwrap();
     assert!(reference.len() >= 20, "{}", reference.len());
     assert!(
@@ -600,17 +588,6 @@ fn finish_modes_normalizes_phase_and_sorts() {
     let rev: Vec<c64> = lam.iter().rev().cloned().collect();
     let nn = lam.len();
     let scaled = Mat::from_fn(5, nn, |r, k| u[(r, nn - 1 - k)] * c(-3.0, 2.0 + k as f64));
-    let info = |s: &str| SolveInfo {
-        solver: s.into(),
-        time_s: 0.0,
-        requested: 0,
-        converged: 0,
-        iterations: 0,
-        op_applications: 0,
-        factorizations: 0,
-        reason: StopReason::Converged,
-        notes: vec![],
-    };
     let params = EigenParams {
         fmax_hz: 1e3,
         ..Default::default()
@@ -679,23 +656,12 @@ fn operator_modes_are_checked_on_the_parts_like_the_assembled_operator() {
         fmax_hz: 1e3,
         ..Default::default()
     };
-    let info = || SolveInfo {
-        solver: "t".into(),
-        time_s: 0.0,
-        requested: 0,
-        converged: 0,
-        iterations: 0,
-        op_applications: 0,
-        factorizations: 0,
-        reason: StopReason::Converged,
-        notes: vec![],
-    };
     for mu in [0.0, 0.4, 1.3] {
         let full = op.at(mu).unwrap();
         let (lam, u) = dense_qep(&full).unwrap();
         let lam: Vec<c64> = lam.iter().map(|l| *l * c(1.0, 1e-4)).collect();
-        let assembled = finish_modes(&full, &lam, u.as_ref(), &params, info()).unwrap();
-        let parts = finish_operator_modes(&op, mu, &lam, u.as_ref(), &params, info()).unwrap();
+        let assembled = finish_modes(&full, &lam, u.as_ref(), &params, info("t")).unwrap();
+        let parts = finish_operator_modes(&op, mu, &lam, u.as_ref(), &params, info("t")).unwrap();
         assert!(!assembled.is_empty());
         assert_eq!(assembled.lambda, parts.lambda);
         for (x, y) in assembled.backward_error.iter().zip(&parts.backward_error) {
@@ -712,7 +678,7 @@ fn operator_modes_are_checked_on_the_parts_like_the_assembled_operator() {
         &[],
         Mat::zeros(6, 0).as_ref(),
         &params,
-        info()
+        info("t")
     )
     .is_err());
 }
