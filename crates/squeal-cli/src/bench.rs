@@ -541,6 +541,9 @@ fn stress_report(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
         baseline_backward_error: f64,
         estimate_ratio: f64,
         flagged: bool,
+        /// The method stopped with an error (e.g. `dense` refusing a full-order problem
+        /// above its `max_dim`): no answer, so neither right nor wrong.
+        failed: bool,
     }
     let base = |r: &BenchRun| -> f64 {
         runs.iter()
@@ -577,7 +580,8 @@ fn stress_report(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
             case: r.case.clone(),
             method: format!("{}/{}", r.basis, r.eigen),
             basis_opts: r.basis_opts.clone(),
-            wrong: !why.is_empty(),
+            wrong: r.status == "ok" && !why.is_empty(),
+            failed: r.status != "ok",
             why,
             max_backward_error: r.errors.max_backward_error,
             baseline_backward_error: b,
@@ -603,7 +607,13 @@ fn stress_report(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
                     format!(" [{}]", r.basis_opts)
                 }
             ),
-            if r.wrong { "WRONG" } else { "ok" },
+            if r.failed {
+                "failed"
+            } else if r.wrong {
+                "WRONG"
+            } else {
+                "ok"
+            },
             r.max_backward_error,
             r.estimate_ratio,
             if r.flagged { "yes" } else { "no" },
