@@ -406,6 +406,13 @@ pub fn parse_band(text: &str) -> Result<[f64; 2]> {
 }
 
 fn main() {
+    // A closed pipe (`squeal ... | head`) ends the process quietly, as for other Unix
+    // tools, instead of a panic in `println!`.
+    #[cfg(unix)]
+    // SAFETY: restoring the default action of one signal before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     if let Err(e) = run() {
         eprintln!("error: {e:#}");
         std::process::exit(1);
