@@ -1,7 +1,7 @@
 //! Operator directories: the constrained frictional operator of one contact set as
 //! Matrix Market files plus an optional index map, a README and a TOML summary.
 
-use crate::mtx::{check_finite, io_err, read_square_with, write_mtx};
+use crate::mtx::{check_finite, io_err, read_mtx, read_square_with, write_mtx};
 use crate::IoError;
 use faer::sparse::SymbolicSparseColMat;
 use squeal_core::{FrictionalOperator, SparseMat};
@@ -22,6 +22,10 @@ pub const FILE_FC: &str = "FC.mtx";
 pub const FILE_FK: &str = "FK.mtx";
 /// The index map `T`, one 0-based integer per line. Optional.
 pub const FILE_T: &str = "T.txt";
+/// The friction load directions `U = T^T P~t^T` (`n x nA`, one column per active pair,
+/// `F_X = U W_X^T`). Optional; with it an imported operator gets the low-rank
+/// (Woodbury) solve path of large undamped problems, as the scene-built one does.
+pub const FILE_U: &str = "U.mtx";
 /// Human-readable description of the directory (written, never read).
 pub const FILE_README: &str = "README.txt";
 /// Machine-readable summary (written, never read by [`read_operator_dir`]).
@@ -108,6 +112,21 @@ pub fn read_operator_dir(dir: impl AsRef<Path>) -> Result<FrictionalOperator, Io
     } else {
         None
     };
+    let u_path = dir.join(FILE_U);
+    let friction_loads = if u_path.exists() {
+        let u = read_mtx(&u_path)?;
+        if u.nrows() != n {
+            return Err(IoError::Shape {
+                file: u_path,
+                nrows: u.nrows(),
+                ncols: u.ncols(),
+                expected: format!("{n} x nA like {FILE_MC} (one column per active contact pair)"),
+            });
+        }
+        Some(u)
+    } else {
+        None
+    };
     Ok(FrictionalOperator {
         mc,
         cc,
@@ -116,7 +135,7 @@ pub fn read_operator_dir(dir: impl AsRef<Path>) -> Result<FrictionalOperator, Io
         fc,
         fk,
         t,
-        friction_loads: None,
+        friction_loads,
     })
 }
 
@@ -274,6 +293,18 @@ pub fn write_operator_dir(
         }
         check_finite(m, &file)?;
     }
+    if let Some(u) = &op.friction_loads {
+        let file = dir.join(FILE_U);
+        if u.nrows() != n {
+            return Err(IoError::Shape {
+                file,
+                nrows: u.nrows(),
+                ncols: u.ncols(),
+                expected: format!("{n} x nA, the operator size (from K_c) by the active pairs"),
+            });
+        }
+        check_finite(u, &file)?;
+    }
     if let Some(t) = &op.t {
         validate_index_map(t, n).map_err(|(line, problem, expected)| IoError::IndexMap {
             file: dir.join(FILE_T),
@@ -318,6 +349,19 @@ pub fn write_operator_dir(
             }
             _ => remove_stale(&file)?,
         }
+    }
+    let u_file = dir.join(FILE_U);
+    match &op.friction_loads {
+        Some(u) => {
+            let comment = format!(
+                "squeal constrained frictional operator: U, friction load directions \
+                 (n x nA, F_X = U W_X^T)\nscene: {}",
+                meta.scene
+            );
+            write_mtx(&u_file, u, &comment)?;
+            written.push(FILE_U);
+        }
+        None => remove_stale(&u_file)?,
     }
     let t_file = dir.join(FILE_T);
     match &op.t {
@@ -402,6 +446,7 @@ scipy.io.mmread reads them):
   {fm:<13} F_M  friction part of the mass (kg)         {fm_p}
   {fc:<13} F_C  friction part of the damping (N s/m)   {fc_p}
   {fk:<13} F_K  friction part of the stiffness (N/m)   {fk_p}
+  {u:<13} U    friction load directions, n x nA (F_X = U W_X^T)  {u_p}
   {t:<13} T    index map u = T u_c, 0-based: line k+1 holds the constrained DOF
                      of unconstrained DOF k; {t_p}
   {toml:<13} machine-readable summary of this README
@@ -436,6 +481,12 @@ Units: SI. Mass kg, damping N s/m, stiffness N/m, displacements m, time s.
         fm_p = present(FILE_FM),
         fc_p = present(FILE_FC),
         fk_p = present(FILE_FK),
+        u = FILE_U,
+        u_p = if op.friction_loads.is_some() {
+            "present (low-rank solve path)"
+        } else {
+            "absent"
+        },
         t_p = if op.t.is_some() {
             "present"
         } else {

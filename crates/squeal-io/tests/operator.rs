@@ -52,6 +52,11 @@ fn assert_same(a: &FrictionalOperator, b: &FrictionalOperator) {
     assert_eq!(a.cc.as_ref().map(bits), b.cc.as_ref().map(bits), "cc");
     assert_eq!(a.fc.as_ref().map(bits), b.fc.as_ref().map(bits), "fc");
     assert_eq!(a.t, b.t, "t");
+    assert_eq!(
+        a.friction_loads.as_ref().map(bits),
+        b.friction_loads.as_ref().map(bits),
+        "friction_loads"
+    );
 }
 
 fn hoffmann() -> FrictionalOperator {
@@ -185,7 +190,17 @@ fn full_operator() -> FrictionalOperator {
         fc: Some(mat(4, &[(2, 1, 2e-5)])),
         fk: mat(4, &[(2, 0, -4.4e6), (3, 1, 1.0e6 / 3.0)]),
         t: Some(vec![0, 1, 2, 3, 2]),
-        friction_loads: None,
+        friction_loads: Some(
+            SparseMat::try_new_from_triplets(
+                4,
+                2,
+                &[
+                    faer::sparse::Triplet::new(2, 0, 1.0),
+                    faer::sparse::Triplet::new(3, 1, -0.5),
+                ],
+            )
+            .unwrap(),
+        ),
     }
 }
 
@@ -236,9 +251,11 @@ fn full_operator_round_trip_reproducible_and_stale_files_removed() {
     undamped.cc = None;
     undamped.fc = None;
     undamped.t = None;
+    undamped.friction_loads = None;
+    assert!(d.join("U.mtx").exists());
     write_operator_dir(&d, &undamped, &meta).unwrap();
     assert!(!d.join("Cc.mtx").exists() && !d.join("FC.mtx").exists());
-    assert!(!d.join("T.txt").exists());
+    assert!(!d.join("T.txt").exists() && !d.join("U.mtx").exists());
     assert_same(&undamped, &read_operator_dir(&d).unwrap());
 }
 
@@ -377,4 +394,17 @@ fn invalid_operator_is_not_written() {
         0,
         "nothing may be written"
     );
+}
+
+#[test]
+fn friction_loads_with_the_wrong_row_count_are_rejected_naming_the_file() {
+    let d = tmp("bad_u");
+    write_hoffmann_files(&d);
+    std::fs::write(
+        d.join("U.mtx"),
+        "%%MatrixMarket matrix coordinate real general\n3 1 1\n1 1 1.0\n",
+    )
+    .unwrap();
+    let msg = err_msg(&d);
+    assert_has(&msg, &["U.mtx", "3 x 1", "2 x nA"]);
 }
