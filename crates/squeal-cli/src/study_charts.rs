@@ -10,7 +10,6 @@
 use anyhow::Result;
 use squeal_analysis::study::{Record, StudyDef, StudySpec};
 use squeal_plot::{contact_map, line_chart, ChartOptions, MapPanel, Series, SeriesStyle};
-use squeal_scene::Zone;
 use std::path::{Path, PathBuf};
 
 /// Draws the charts of a study into `dir`; returns the files written.
@@ -25,19 +24,32 @@ pub fn draw(dir: &Path, def: &StudyDef, records: &[Record]) -> Result<Vec<PathBu
     }
 }
 
-fn rect(r: &Record) -> Option<[f64; 4]> {
-    match r.case.zone {
-        Zone::Rectangle {
-            x0_m,
-            y0_m,
-            a_m,
-            b_m,
-        } => Some([x0_m, y0_m, a_m, b_m]),
-        _ => None,
+/// A number for a file name: to 1e-6, `.` as `_` (`14.2` -> `14_2`).
+/// A marker chart of the non-empty `series`; no file when every series is empty.
+fn scatter(
+    stem: &Path,
+    title: &str,
+    x: &str,
+    y: &str,
+    series: Vec<Series>,
+) -> Result<Vec<PathBuf>> {
+    let series: Vec<Series> = series
+        .into_iter()
+        .filter(|s| !s.points.is_empty())
+        .collect();
+    if series.is_empty() {
+        return Ok(Vec::new());
     }
+    Ok(line_chart(
+        stem,
+        title,
+        x,
+        y,
+        &series,
+        &ChartOptions::default(),
+    )?)
 }
 
-/// A number for a file name: to 1e-6, `.` as `_` (`14.2` -> `14_2`).
 fn tag(v: f64) -> String {
     format!("{}", (v * 1e6).round() / 1e6).replace('.', "_")
 }
@@ -67,12 +79,12 @@ fn macro_charts(
         for &b in bs {
             let mut by_a: std::collections::BTreeMap<i64, &Record> = Default::default();
             for r in recs.iter().filter(|r| r.case.mu == mu) {
-                let Some(z) = rect(r) else { continue };
+                let Some(z) = r.rectangle() else { continue };
                 if z[3] != b {
                     continue;
                 }
                 let off = |r: &Record| {
-                    let z = rect(r).unwrap_or_default();
+                    let z = r.rectangle().unwrap_or_default();
                     (z[0] + z[2] / 2.0 - face[0] / 2.0).hypot(z[1] + z[3] / 2.0 - face[1] / 2.0)
                 };
                 let key = (z[2] * 1e6).round() as i64;
@@ -91,7 +103,7 @@ fn macro_charts(
                 let mut pts = Vec::new();
                 let mut hi = Vec::new();
                 for r in by_a.values() {
-                    let a = rect(r).unwrap_or_default()[2] * 1e3;
+                    let a = r.rectangle().unwrap_or_default()[2] * 1e3;
                     for m in &r.modes {
                         pts.push((a, m[pick]));
                         hi.push(m[1] > tol);
@@ -174,18 +186,14 @@ fn macro_charts(
             style: SeriesStyle::Markers,
             highlight: Vec::new(),
         })
-        .filter(|s| !s.points.is_empty())
         .collect();
-    if !series.is_empty() {
-        files.extend(line_chart(
-            &dir.join("unstable_area"),
-            "Unstable zones: frequency of their unstable modes vs zone area",
-            "zone area a b (mm^2)",
-            "unstable frequency (Hz)",
-            &series,
-            &ChartOptions::default(),
-        )?);
-    }
+    files.extend(scatter(
+        &dir.join("unstable_area"),
+        "Unstable zones: frequency of their unstable modes vs zone area",
+        "zone area a b (mm^2)",
+        "unstable frequency (Hz)",
+        series,
+    )?);
     Ok(files)
 }
 
@@ -257,18 +265,14 @@ fn meso_charts(
             style: SeriesStyle::Markers,
             highlight: Vec::new(),
         })
-        .filter(|s| !s.points.is_empty())
         .collect();
-    if !series.is_empty() {
-        files.extend(line_chart(
-            &dir.join("dvr_vs_freq"),
-            "Unstable modes of the plateau layouts",
-            "frequency (Hz)",
-            "DvR = Re(lambda)/Im(lambda)",
-            &series,
-            &ChartOptions::default(),
-        )?);
-    }
+    files.extend(scatter(
+        &dir.join("dvr_vs_freq"),
+        "Unstable modes of the plateau layouts",
+        "frequency (Hz)",
+        "DvR = Re(lambda)/Im(lambda)",
+        series,
+    )?);
     // Figures 23-26: layouts that trigger (largest DvR) or suppress each coupling (stable
     // in that class although they hold the most pairs)
     let face = def.grid.face_m;

@@ -47,6 +47,22 @@ pub struct Record {
     pub error: Option<String>,
 }
 
+impl Record {
+    /// The zone `[x0, y0, a, b]` (m, from the pin face's corner) of a macroscopic case;
+    /// `None` for plateau layouts.
+    pub fn rectangle(&self) -> Option<[f64; 4]> {
+        match self.case.zone {
+            squeal_scene::Zone::Rectangle {
+                x0_m,
+                y0_m,
+                a_m,
+                b_m,
+            } => Some([x0_m, y0_m, a_m, b_m]),
+            _ => None,
+        }
+    }
+}
+
 /// Wall times of one case (s): a line of `timings.jsonl`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Timing {

@@ -3,7 +3,6 @@
 use super::run::{Record, Timing, UnstableMode};
 use super::{CaseList, Skipped, SolveSpec, StudyDef, StudySpec};
 use serde::{Deserialize, Serialize};
-use squeal_scene::Zone;
 
 /// Unstable cases of one class.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -163,17 +162,7 @@ fn class_summaries(solve: &SolveSpec, records: &[&Record], with_zones: bool) -> 
                 freq_hz: fix(range(&mut modes.iter().map(|m| m.freq_hz))),
                 dvr: fix(range(&mut modes.iter().map(|m| m.dvr))),
                 zones_m: if with_zones {
-                    of.iter()
-                        .filter_map(|r| match r.case.zone {
-                            Zone::Rectangle {
-                                x0_m,
-                                y0_m,
-                                a_m,
-                                b_m,
-                            } => Some([x0_m, y0_m, a_m, b_m]),
-                            _ => None,
-                        })
-                        .collect()
+                    of.iter().filter_map(|r| r.rectangle()).collect()
                 } else {
                     Vec::new()
                 },
