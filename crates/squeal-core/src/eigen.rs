@@ -91,6 +91,24 @@ pub struct SolveInfo {
     pub notes: Vec<String>,
 }
 
+impl SolveInfo {
+    /// A report of `solver` with every count zero, stopped on convergence, no notes: the
+    /// start of every backend's report.
+    pub fn new(solver: impl Into<String>) -> Self {
+        Self {
+            solver: solver.into(),
+            time_s: 0.0,
+            requested: 0,
+            converged: 0,
+            iterations: 0,
+            op_applications: 0,
+            factorizations: 0,
+            reason: StopReason::Converged,
+            notes: Vec::new(),
+        }
+    }
+}
+
 /// Real normal modes in a band, sorted by frequency.
 #[derive(Debug, Clone)]
 pub struct RealModes {
@@ -183,15 +201,8 @@ pub fn solve_symmetric_band(
     let sigma = -(two_pi * shift_hz).powi(2);
     let op = ShiftInvert::new(problem.k, problem.m, sigma)?;
     let mut info = SolveInfo {
-        solver: solver.to_string(),
-        time_s: 0.0,
-        requested: 0,
-        converged: 0,
-        iterations: 0,
-        op_applications: 0,
         factorizations: 1,
-        reason: StopReason::Converged,
-        notes: Vec::new(),
+        ..SolveInfo::new(solver)
     };
     let top = (two_pi * params.fmax_hz).powi(2);
 

@@ -795,17 +795,7 @@ fn band_solve(
             format!("need max_nev >= 1, radius_factor >= 1, margin_rel >= 0; got {options:?}"),
         ));
     }
-    let mut info = SolveInfo {
-        solver: solver.to_string(),
-        time_s: 0.0,
-        requested: 0,
-        converged: 0,
-        iterations: 0,
-        op_applications: 0,
-        factorizations: 0,
-        reason: StopReason::Converged,
-        notes: Vec::new(),
-    };
+    let mut info = SolveInfo::new(solver);
     if 2 * n <= params.dense_below {
         info.notes.push(format!(
             "companion size 2n = {} <= {}: solved densely instead of `{solver}`",
@@ -1232,6 +1222,21 @@ struct QepNorms {
 }
 
 impl QepNorms {
+    /// The backward error `||r|| / ((|l|^2 ||M|| + |l| ||C|| + ||K||) ||u||)` from the
+    /// residual norm `num` and the vector norm `un`; `0` for a zero residual on a zero
+    /// scale, infinite for a nonzero one.
+    fn relative(&self, lambda: c64, num: f64, un: f64) -> f64 {
+        let al = lambda.norm();
+        let den = (al * al * self.m + al * self.c + self.k) * un;
+        if den > 0.0 {
+            num / den
+        } else if num == 0.0 {
+            0.0
+        } else {
+            f64::INFINITY
+        }
+    }
+
     fn of(qep: &Qep) -> Self {
         Self {
             m: norm1(qep.m.as_ref()),
@@ -1322,16 +1327,7 @@ fn backward_error_with(qep: &Qep, norms: &QepNorms, lambda: c64, u: &[c64]) -> f
     }
     t.iter_mut().for_each(|v| *v *= lambda);
     spmv_complex_add(qep.k.as_ref(), u, &mut t);
-    let num = norm2_c(&t);
-    let al = lambda.norm();
-    let den = (al * al * norms.m + al * norms.c + norms.k) * norm2_c(u);
-    if den > 0.0 {
-        num / den
-    } else if num == 0.0 {
-        0.0
-    } else {
-        f64::INFINITY
-    }
+    norms.relative(lambda, norm2_c(&t), norm2_c(u))
 }
 
 /// Backward errors of the pairs `(lambda[j], u[:, j])` on `qep`, the same numbers as
@@ -1388,18 +1384,7 @@ fn backward_errors(
             }
         }
         (0..w)
-            .map(|j| {
-                let (num, un) = (num[j].sqrt(), un[j].sqrt());
-                let al = lambda[lo + j].norm();
-                let den = (al * al * norms.m + al * norms.c + norms.k) * un;
-                if den > 0.0 {
-                    num / den
-                } else if num == 0.0 {
-                    0.0
-                } else {
-                    f64::INFINITY
-                }
-            })
+            .map(|j| norms.relative(lambda[lo + j], num[j].sqrt(), un[j].sqrt()))
             .collect()
     };
     let mid = k / 2;

@@ -23,7 +23,7 @@ use squeal_core::eigen::{dense_symmetric, finish_real_modes, validate_params};
 use squeal_core::qep::{check_qep, dense_qep, finish_modes};
 use squeal_core::{
     ComplexModes, EigenParams, EigenSolver, Error, Params, Qep, RealModes, Registry, Result,
-    SolveInfo, StopReason, SymmetricProblem,
+    SolveInfo, SymmetricProblem,
 };
 use std::time::Instant;
 
@@ -89,15 +89,9 @@ impl DenseSolver {
 
     fn info(&self, count: usize) -> SolveInfo {
         SolveInfo {
-            solver: NAME.to_string(),
-            time_s: 0.0,
             requested: count,
             converged: count,
-            iterations: 0,
-            op_applications: 0,
-            factorizations: 0,
-            reason: StopReason::Converged,
-            notes: Vec::new(),
+            ..SolveInfo::new(NAME)
         }
     }
 }

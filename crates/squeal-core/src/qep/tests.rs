@@ -3,19 +3,8 @@ use crate::eigen::EigenParams;
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
 
-/// A blank [`SolveInfo`] of solver `solver`.
 fn info(solver: &str) -> SolveInfo {
-    SolveInfo {
-        solver: solver.into(),
-        time_s: 0.0,
-        requested: 0,
-        converged: 0,
-        iterations: 0,
-        op_applications: 0,
-        factorizations: 0,
-        reason: StopReason::Converged,
-        notes: vec![],
-    }
+    SolveInfo::new(solver)
 }
 
 fn c(re: f64, im: f64) -> c64 {

@@ -1,5 +1,5 @@
 use super::*;
-use crate::eigen::{dense_symmetric, finish_real_modes, SolveInfo, StopReason};
+use crate::eigen::{dense_symmetric, finish_real_modes, SolveInfo};
 use crate::qep::finish_modes;
 use crate::qep::{backward_error, dense_qep, Qep};
 
@@ -79,17 +79,7 @@ impl EigenSolver for Dense {
 }
 
 fn info() -> SolveInfo {
-    SolveInfo {
-        solver: "dense-test".into(),
-        time_s: 0.0,
-        requested: 0,
-        converged: 0,
-        iterations: 0,
-        op_applications: 0,
-        factorizations: 0,
-        reason: StopReason::Converged,
-        notes: vec![],
-    }
+    SolveInfo::new("dense-test")
 }
 
 fn wide_band() -> EigenParams {
