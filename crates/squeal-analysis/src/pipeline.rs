@@ -3,7 +3,8 @@
 //! per active set and handed unchanged to any eigen solver or reduction basis.
 
 use squeal_contact::{
-    build_operator, problem, reference_load, solve_on, ContactError, ContactSet, LoadedEquilibrium,
+    build_operator, damping_matrix, problem, reference_load, solve_on, ContactError, ContactSet,
+    LoadedEquilibrium,
 };
 use squeal_core::contact::Condensation;
 use squeal_core::qep::ComplexModes;
@@ -113,16 +114,28 @@ impl Prepared {
         )?)
     }
 
-    /// The frictional operator of an active set.
+    /// The frictional operator of an active set, with the scene's damping.
     pub fn operator(&self, active: &[bool]) -> Result<FrictionalOperator> {
-        Ok(build_operator(
-            self.model.m.as_ref(),
-            None,
-            self.model.k.as_ref(),
-            &self.set,
-            active,
-        )?)
+        scene_operator(&self.model, &self.scene, &self.set, active)
     }
+}
+
+/// The frictional operator of the closed pairs `active` of `set` on `model`, damped as
+/// `scene.damping` says (see [`squeal_contact::damping`]).
+pub fn scene_operator(
+    model: &Model,
+    scene: &Scene,
+    set: &ContactSet,
+    active: &[bool],
+) -> Result<FrictionalOperator> {
+    let c = damping_matrix(model, set, active, &scene.damping)?;
+    Ok(build_operator(
+        model.m.as_ref(),
+        c.as_ref().map(|c| c.as_ref()),
+        model.k.as_ref(),
+        set,
+        active,
+    )?)
 }
 
 /// Complex modes of `op` at `mu` with the named eigen solver, timed.

@@ -255,10 +255,12 @@ pub fn export(
             ),
         },
     )?;
+    let c =
+        squeal_contact::damping_matrix(&prep.model, &prep.set, &eq.eq.active, &prep.scene.damping)?;
     squeal_contact::files::write_full_form(
         out,
         &prep.model.m,
-        None,
+        c.as_ref(),
         &prep.model.k,
         &prep.set,
         &eq.eq.active,
@@ -268,7 +270,7 @@ pub fn export(
     text.push_str(&format!(
         "\nFULL FORM (the same operator before elimination)\n\
          M.mtx, K.mtx: mass (kg) and stiffness (N/m) on the {} free DOFs of the model\n\
-         (Dirichlet DOFs eliminated; no damping in this scene, so no C.mtx).\n\
+         (Dirichlet DOFs eliminated); {}.\n\
          pairs.csv: one row per candidate contact pair ({} pairs, {active} active at mu = {mu}):\n\
          pin_dof_x..z, disc_dof_x..z (0-based rows of M and K), x_m, y_m (position), nx, ny, nz\n\
          (normal, +z from the disc into the pin), ex, ey, ez (unit sliding direction: the disc's\n\
@@ -278,6 +280,11 @@ pub fn export(
          apart. `squeal stability --operator DIR` reads the constrained form when present and\n\
          builds it from the full form otherwise.\n",
         prep.model.dofs.n_free(),
+        if c.is_some() {
+            "C.mtx: damping (N s/m) of the scene's [damping] for this active set"
+        } else {
+            "no damping in this scene, so no C.mtx"
+        },
         prep.set.len()
     ));
     std::fs::write(&readme, text)?;

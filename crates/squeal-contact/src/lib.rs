@@ -14,13 +14,15 @@
 //!   homogeneous in `delta`, so a target total normal force is met exactly by one
 //!   solve and a scaling.
 //! - [`build_operator`]: the constrained frictional operator of an active set (see
-//!   [`operator`]).
+//!   [`operator`]), with the scene's damping from [`damping_matrix`].
 //!
 //! Units: SI (m, N, kg, s).
 
+pub mod damping;
 pub mod files;
 pub mod operator;
 
+pub use damping::damping_matrix;
 pub use operator::build_operator;
 
 use squeal_core::contact::{Condensation, ContactProblem, Equilibrium};

@@ -1417,6 +1417,8 @@ pub fn band_pairs(lambda: &[c64], params: &EigenParams) -> Vec<(f64, usize)> {
         .enumerate()
         .filter(|(_, l)| l.re.is_finite() && l.im.is_finite())
         .filter(|(_, l)| l.im > REAL_ROOT_REL * l.norm())
+        // heavily damped roots are no vibration modes (see `finish_modes`)
+        .filter(|(_, l)| -l.re <= l.im)
         .map(|(i, l)| (l.im / two_pi, i))
         .filter(|&(f, _)| f >= lo && f <= hi)
         .collect();
@@ -1431,7 +1433,12 @@ pub fn band_pairs(lambda: &[c64], params: &EigenParams) -> Vec<(f64, usize)> {
 /// computes frequencies, DvR and backward errors, and sorts by frequency.
 ///
 /// Real roots (`|Im| <= REAL_ROOT_REL |lambda|`, rigid-body zeros included) are not
-/// oscillating modes and are dropped. The band is inclusive with a relative slack of
+/// oscillating modes and are dropped, and so are heavily damped roots with
+/// `Re(lambda) < -Im(lambda)` (damping ratio `-Re / |lambda|` above `1/sqrt 2`): a damped
+/// operator has them (overdamped modes under stiffness-proportional damping, where a
+/// cluster of real roots near `-1/beta` comes out of a dense solver as pairs with
+/// round-off imaginary parts), they can never be unstable, and a shift-invert solver aimed
+/// at the band does not see them. The band is inclusive with a relative slack of
 /// `1e-12`. Vectors get unit 2-norm and a deterministic phase (their largest-modulus
 /// component real positive). `info` is passed through (the caller sets `time_s`).
 pub fn finish_modes(

@@ -10,7 +10,7 @@ mod spec;
 
 pub use model::{build, element_size, BodyKind, BodyStats, ContactGrid, Model, SizeRule};
 pub use spec::{
-    ContactSpec, Disc, Hat, Load, MaterialSpec, MeshRule, Pin, Plate, Scene, Study, Zone,
+    ContactSpec, Damping, Disc, Hat, Load, MaterialSpec, MeshRule, Pin, Plate, Scene, Study, Zone,
     BUILTIN_SCENES,
 };
 

@@ -174,6 +174,28 @@ impl ContactGrid {
     pub fn is_empty(&self) -> bool {
         self.pin_nodes.is_empty()
     }
+
+    /// Tributary area of each pair (m^2): half the distance to the neighbouring grid
+    /// lines on each side, in x and in y; they sum to the face area.
+    pub fn tributary_areas(&self) -> Vec<f64> {
+        let width = |v: &[f64], i: usize| {
+            let lo = if i == 0 {
+                v[0]
+            } else {
+                0.5 * (v[i - 1] + v[i])
+            };
+            let hi = if i + 1 == v.len() {
+                v[i]
+            } else {
+                0.5 * (v[i] + v[i + 1])
+            };
+            hi - lo
+        };
+        self.ij
+            .iter()
+            .map(|&[i, j]| width(&self.xs, i) * width(&self.ys, j))
+            .collect()
+    }
 }
 
 /// Pairs each pin face node with the disc face node at the same (x, y) to within

@@ -184,6 +184,9 @@ pub struct Scene {
     /// Friction coefficient and frequency band of the study.
     #[serde(default)]
     pub study: Study,
+    /// Damping of the stability analysis (none by default).
+    #[serde(default, skip_serializing_if = "Damping::is_none")]
+    pub damping: Damping,
 }
 
 /// Which contact pairs may carry load (the effective zone is then decided by the
@@ -374,6 +377,127 @@ impl Default for Study {
     }
 }
 
+/// Damping of the stability analysis: `C = alpha M + beta K + C_t`, where `C_t` holds
+/// viscous tangential dashpots between the pin and disc nodes of every closed contact
+/// pair. None of it changes the static sliding equilibrium. Absent or all zero means
+/// undamped (`C = 0`), the paper's setting.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct Damping {
+    /// Rayleigh mass-proportional coefficient `alpha` (1/s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rayleigh_alpha_per_s: Option<f64>,
+    /// Rayleigh stiffness-proportional coefficient `beta` (s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rayleigh_beta_s: Option<f64>,
+    /// Rayleigh damping given instead as a modal damping ratio (dimensionless) reached at
+    /// both frequencies of `rayleigh_freqs_hz`; excludes `rayleigh_alpha_per_s` and
+    /// `rayleigh_beta_s`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rayleigh_ratio: Option<f64>,
+    /// The two frequencies (Hz) where the modal damping ratio equals `rayleigh_ratio`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rayleigh_freqs_hz: Option<[f64; 2]>,
+    /// Viscous tangential contact damping per unit contact area (N s/m^3): each closed
+    /// pair gets a dashpot `c = value x tributary area` on the relative in-plane velocity
+    /// of its pin and disc nodes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_tangential_n_s_per_m3: Option<f64>,
+}
+
+impl Damping {
+    /// Whether no damping is given (the scene is undamped).
+    pub fn is_none(&self) -> bool {
+        *self == Damping::default()
+    }
+
+    /// The Rayleigh coefficients `(alpha (1/s), beta (s))`; a ratio `zeta` at
+    /// `f1`, `f2` gives `alpha = 2 zeta w1 w2 / (w1 + w2)`, `beta = 2 zeta / (w1 + w2)`.
+    pub fn rayleigh(&self) -> (f64, f64) {
+        match (self.rayleigh_ratio, self.rayleigh_freqs_hz) {
+            (Some(z), Some([f1, f2])) => {
+                let (w1, w2) = (
+                    2.0 * std::f64::consts::PI * f1,
+                    2.0 * std::f64::consts::PI * f2,
+                );
+                (2.0 * z * w1 * w2 / (w1 + w2), 2.0 * z / (w1 + w2))
+            }
+            _ => (
+                self.rayleigh_alpha_per_s.unwrap_or(0.0),
+                self.rayleigh_beta_s.unwrap_or(0.0),
+            ),
+        }
+    }
+
+    /// Contact dashpot coefficient per unit area (N s/m^3), 0 when absent.
+    pub fn contact_tangential(&self) -> f64 {
+        self.contact_tangential_n_s_per_m3.unwrap_or(0.0)
+    }
+
+    /// Whether the damping matrix is zero.
+    pub fn is_zero(&self) -> bool {
+        let (a, b) = self.rayleigh();
+        a == 0.0 && b == 0.0 && self.contact_tangential() == 0.0
+    }
+
+    fn validate(&self, file: &str) -> Result<()> {
+        let field = |f: &str, m: String| SceneError::Field {
+            file: file.into(),
+            field: format!("damping.{f}"),
+            message: m,
+        };
+        let non_negative = |f: &str, v: Option<f64>, unit: &str| -> Result<()> {
+            match v {
+                Some(v) if !(v.is_finite() && v >= 0.0) => Err(field(
+                    f,
+                    format!("expected a finite value >= 0 in {unit}, got {v}"),
+                )),
+                _ => Ok(()),
+            }
+        };
+        non_negative("rayleigh_alpha_per_s", self.rayleigh_alpha_per_s, "1/s")?;
+        non_negative("rayleigh_beta_s", self.rayleigh_beta_s, "s")?;
+        non_negative(
+            "contact_tangential_n_s_per_m3",
+            self.contact_tangential_n_s_per_m3,
+            "N s/m^3",
+        )?;
+        match (self.rayleigh_ratio, self.rayleigh_freqs_hz) {
+            (None, None) => Ok(()),
+            (Some(z), Some([f1, f2])) => {
+                if self.rayleigh_alpha_per_s.is_some() || self.rayleigh_beta_s.is_some() {
+                    return Err(field(
+                        "rayleigh_ratio",
+                        "give either rayleigh_ratio with rayleigh_freqs_hz or                          rayleigh_alpha_per_s / rayleigh_beta_s, not both"
+                            .into(),
+                    ));
+                }
+                if !(z.is_finite() && (0.0..1.0).contains(&z)) {
+                    return Err(field(
+                        "rayleigh_ratio",
+                        format!("expected a damping ratio in [0, 1), got {z}"),
+                    ));
+                }
+                if !(f1.is_finite() && f2.is_finite() && f1 > 0.0 && f2 > 0.0) {
+                    return Err(field(
+                        "rayleigh_freqs_hz",
+                        format!("expected two positive frequencies in Hz, got [{f1}, {f2}]"),
+                    ));
+                }
+                Ok(())
+            }
+            (Some(_), None) => Err(field(
+                "rayleigh_freqs_hz",
+                "rayleigh_ratio needs rayleigh_freqs_hz = [f1, f2] (Hz)".into(),
+            )),
+            (None, Some(_)) => Err(field(
+                "rayleigh_ratio",
+                "rayleigh_freqs_hz needs rayleigh_ratio (the damping ratio at both)".into(),
+            )),
+        }
+    }
+}
+
 impl Scene {
     /// Parses a scene from TOML text; `file` names it in errors.
     pub fn from_toml(text: &str, file: &str) -> Result<Scene> {
@@ -464,6 +588,7 @@ impl Scene {
 
     /// Checks every dimension; errors name the field and the expected range.
     pub fn validate(&self, file: &str) -> Result<()> {
+        self.damping.validate(file)?;
         let field = |f: &str, m: String| SceneError::Field {
             file: file.into(),
             field: f.into(),

@@ -318,3 +318,80 @@ fn masks_and_plateaus_are_checked_and_reproducible() {
         .to_string();
     assert!(e.contains("contact.zone.patch_m"), "{e}");
 }
+
+#[test]
+fn damping_is_parsed_checked_and_written_back() {
+    let base = Scene::builtin("pin-on-disc").unwrap();
+    assert!(base.damping.is_none() && base.damping.is_zero());
+    assert!(
+        !base.to_toml().contains("[damping]"),
+        "undamped scenes write no table"
+    );
+    // a ratio at two frequencies: Rayleigh damping meets it at both, less in between
+    let text = base.to_toml()
+        + "\n[damping]\nrayleigh_ratio = 0.01\nrayleigh_freqs_hz = [1000.0, 8000.0]\n\
+           contact_tangential_n_s_per_m3 = 2.5e4\n";
+    let s = Scene::from_toml(&text, "damped.toml").unwrap();
+    let (alpha, beta) = s.damping.rayleigh();
+    let zeta = |f: f64| {
+        let w = 2.0 * std::f64::consts::PI * f;
+        alpha / (2.0 * w) + beta * w / 2.0
+    };
+    for f in [1000.0, 8000.0] {
+        approx::assert_relative_eq!(zeta(f), 0.01, max_relative = 1e-12);
+    }
+    assert!(zeta(3000.0) < 0.01);
+    assert_eq!(s.damping.contact_tangential(), 2.5e4);
+    assert_eq!(Scene::from_toml(&s.to_toml(), "again").unwrap(), s);
+    let cases = [
+        (
+            "rayleigh_alpha_per_s = -1.0",
+            "damping.rayleigh_alpha_per_s",
+        ),
+        ("rayleigh_ratio = 0.02", "damping.rayleigh_freqs_hz"),
+        (
+            "rayleigh_freqs_hz = [100.0, 200.0]",
+            "damping.rayleigh_ratio",
+        ),
+        (
+            "rayleigh_ratio = 0.02\nrayleigh_freqs_hz = [100.0, 200.0]\nrayleigh_beta_s = 1e-7",
+            "damping.rayleigh_ratio",
+        ),
+        (
+            "rayleigh_ratio = 1.5\nrayleigh_freqs_hz = [100.0, 200.0]",
+            "damping.rayleigh_ratio",
+        ),
+        (
+            "rayleigh_ratio = 0.01\nrayleigh_freqs_hz = [0.0, 200.0]",
+            "damping.rayleigh_freqs_hz",
+        ),
+        (
+            "contact_tangential_n_s_per_m3 = -3.0",
+            "damping.contact_tangential",
+        ),
+        ("viscous = 1.0", "viscous"),
+    ];
+    for (body, field) in cases {
+        let bad = base.to_toml() + "\n[damping]\n" + body + "\n";
+        let e = Scene::from_toml(&bad, "bad.toml").unwrap_err().to_string();
+        assert!(e.contains("bad.toml") && e.contains(field), "{body}: {e}");
+    }
+}
+
+#[test]
+fn tributary_areas_cover_the_pin_face() {
+    let s = Scene::builtin("pin-on-disc-coarse").unwrap();
+    let m = build(&s, BodyKind::All, &registry(), "coarse").unwrap();
+    let grid = m.contact.as_ref().unwrap();
+    let areas = grid.tributary_areas();
+    let p = s.pin.as_ref().unwrap();
+    approx::assert_relative_eq!(
+        areas.iter().sum::<f64>(),
+        p.size_x_m * p.size_y_m,
+        max_relative = 1e-12
+    );
+    // corner pairs carry a quarter of an interior pair's area on a uniform grid
+    let max = areas.iter().cloned().fold(0.0, f64::max);
+    let min = areas.iter().cloned().fold(f64::INFINITY, f64::min);
+    approx::assert_relative_eq!(min * 4.0, max, max_relative = 1e-9);
+}

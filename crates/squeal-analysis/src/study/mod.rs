@@ -428,6 +428,9 @@ pub struct StudyDef {
     pub dofs: usize,
     /// Rotation sense of the disc.
     pub rotation: f64,
+    /// Damping of the scene (absent: undamped).
+    #[serde(default, skip_serializing_if = "squeal_scene::Damping::is_none")]
+    pub damping: squeal_scene::Damping,
     /// The contact grid.
     pub grid: GridInfo,
     /// What varies.
@@ -577,6 +580,7 @@ impl StudyDef {
             scene_toml: scene.to_toml(),
             dofs: model.dofs.n_free(),
             rotation: scene.study.rotation,
+            damping: scene.damping.clone(),
             grid: GridInfo::of(model)?,
             study,
             solve,

@@ -6,9 +6,9 @@ use super::{files, input, Case, CaseList, Result, Shard, SolveSpec, StudyDef, St
 use crate::jsonl;
 use crate::pipeline::{Method, PipelineError};
 use serde::{Deserialize, Serialize};
-use squeal_contact::{build_operator, ContactSet};
+use squeal_contact::{build_operator, damping_matrix, ContactSet};
 use squeal_core::Registry;
-use squeal_scene::Model;
+use squeal_scene::{Damping, Model};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
@@ -88,6 +88,7 @@ pub struct Timing {
 pub fn run_case(
     model: &Model,
     rotation: f64,
+    damping: &Damping,
     solve: &SolveSpec,
     case: &Case,
     method: &mut Method,
@@ -110,12 +111,14 @@ pub fn run_case(
         let set = ContactSet::new(model, &case.zone, rotation)?;
         t.contact_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
+        let active = vec![true; set.len()];
+        let c = damping_matrix(model, &set, &active, damping)?;
         let op = build_operator(
             model.m.as_ref(),
-            None,
+            c.as_ref().map(|c| c.as_ref()),
             model.k.as_ref(),
             &set,
-            &vec![true; set.len()],
+            &active,
         )?;
         t.operator_s = t1.elapsed().as_secs_f64();
         let (modes, basis_size, _) = method.solve(&op, case.mu, true)?;
@@ -405,7 +408,7 @@ pub fn run(
             }
             let i = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
             let Some(case) = todo.get(i) else { break };
-            let (rec, t) = run_case(model, rotation, &def.solve, case, &mut method);
+            let (rec, t) = run_case(model, rotation, &def.damping, &def.solve, case, &mut method);
             if !finish(rec, t) {
                 break;
             }

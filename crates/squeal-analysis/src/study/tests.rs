@@ -41,6 +41,7 @@ fn def(study: StudySpec) -> StudyDef {
         scene_toml: String::new(),
         dofs: 100,
         rotation: 1.0,
+        damping: Default::default(),
         grid: grid(21, 0.020),
         study,
         solve: solve(),

@@ -696,3 +696,24 @@ fn dense_qep_timing() {
         assert_eq!(lam.len(), 2 * n);
     }
 }
+
+#[test]
+fn band_pairs_drop_real_and_heavily_damped_roots_only() {
+    let w = 2.0 * std::f64::consts::PI * 1000.0;
+    let lambda = [
+        c(-0.01 * w, w),        // lightly damped: kept
+        c(0.05 * w, 1.1 * w),   // unstable: kept
+        c(-0.99 * w, w),        // damping ratio 0.70: kept
+        c(-1.01 * w, w),        // damping ratio 0.71 > 1/sqrt 2: dropped
+        c(-5e5, 2.0),           // overdamped cluster member: dropped
+        c(-3.0 * w, 1e-12 * w), // real root: dropped
+        c(0.0, -w),             // conjugate member: dropped
+    ];
+    let params = EigenParams {
+        fmin_hz: 0.0,
+        fmax_hz: 5000.0,
+        ..EigenParams::default()
+    };
+    let kept: Vec<usize> = band_pairs(&lambda, &params).iter().map(|p| p.1).collect();
+    assert_eq!(kept, vec![2, 0, 1]);
+}
