@@ -34,11 +34,11 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// The expected format, quoted in errors.
-const EXPECTED_FORMAT: &str = "expected MSH 4.1 ASCII (`$MeshFormat` then `4.1 0 8`; \
+const EXPECTED_FORMAT: &str = "MSH 4.1 ASCII (`$MeshFormat` then `4.1 0 8`; \
                                export with `gmsh -format msh41` and Mesh.Binary = 0)";
 
 /// What a hexahedral mesh file must contain, quoted in element-type errors.
-const EXPECTED_HEX: &str = "expected 8-node hexahedra (type 5), with 4-node quadrangles (3), \
+const EXPECTED_HEX: &str = "8-node hexahedra (type 5), with 4-node quadrangles (3), \
                             lines (1) or points (15) for physical groups";
 
 /// Name and node count of a Gmsh element type.

@@ -164,6 +164,7 @@ fn fails(name: &str, text: &str, want: &[&str]) -> String {
     let e = e.to_string();
     assert!(e.contains(name), "names the file: {e}");
     assert!(e.contains("expected"), "says what was expected: {e}");
+    assert!(!e.contains("expected expected"), "{e}");
     for w in want {
         assert!(e.contains(w), "`{w}` in: {e}");
     }
