@@ -38,7 +38,8 @@ pub struct SizeRule {
     pub wavelength_m: f64,
     /// Target element edge (m).
     pub element_size_m: f64,
-    /// Elements in each direction (r, theta, z for the disc; x, y, z for blocks).
+    /// Elements in each direction (r, theta, z for the disc; x, y, z for blocks); for an
+    /// imported mesh `[0, 0, 0]` (the disc) or the pin face's `[nx, ny, 0]`.
     pub divisions: [usize; 3],
 }
 

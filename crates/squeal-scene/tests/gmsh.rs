@@ -212,6 +212,15 @@ fn imported_pin_and_disc_pair_up() {
     let model2 = build(&s2, BodyKind::All, &reg, &name2).unwrap();
     assert_same_model(&generated, &model2, 1e-12);
     assert_eq!(model2.contact.as_ref().unwrap().len(), 25);
+
+    // the generated pin on the imported disc
+    let mut s3 = base.clone();
+    s3.disc.as_mut().unwrap().hat = None;
+    s3.disc.as_mut().unwrap().mesh = import("disc.msh", Some("friction"), &["clamp"], 1.0);
+    let (s3, name3) = via_file(&s3, &dir).unwrap();
+    let model3 = build(&s3, BodyKind::All, &reg, &name3).unwrap();
+    assert_same_model(&generated, &model3, 1e-14);
+    assert_eq!(model3.contact.as_ref().unwrap(), g);
 }
 
 #[test]
