@@ -59,6 +59,24 @@ pub fn info(registry: &Registry, scene: &Scene, file: &str) -> Result<()> {
             s.divisions
         );
     }
+    for (body, imp) in [
+        ("disc", scene.disc.as_ref().and_then(|d| d.mesh.as_ref())),
+        ("pin", scene.pin.as_ref().and_then(|p| p.mesh.as_ref())),
+    ] {
+        if let Some(imp) = imp {
+            let path = imp
+                .loaded
+                .as_ref()
+                .map_or_else(|| imp.file.clone(), |l| l.path.display().to_string());
+            println!(
+                "  {body:<12} mesh imported from {path} (scale {} to m), contact group {}, \
+                 fixed groups [{}]",
+                imp.scale,
+                imp.contact_group.as_deref().unwrap_or("-"),
+                imp.fixed_groups.join(", ")
+            );
+        }
+    }
     match &model.contact {
         Some(c) => println!(
             "\ncontact: {} node-to-node pairs ({} x {} grid, step {:.3} mm), max (x, y) mismatch {:.1e} m",

@@ -154,6 +154,19 @@ pub enum IoError {
         /// What a valid map looks like.
         expected: String,
     },
+    /// A Gmsh MSH file that is not a readable MSH 4.1 ASCII hexahedral mesh (or a mesh
+    /// that cannot be written as one).
+    #[error("{}{}: {problem}; expected {expected}", file.display(), at_line(line))]
+    Msh {
+        /// The file.
+        file: PathBuf,
+        /// 1-based line number; `None` for a defect of the whole file.
+        line: Option<usize>,
+        /// What is wrong.
+        problem: String,
+        /// What squeal reads.
+        expected: String,
+    },
     /// Operator metadata that cannot be written faithfully (e.g. a non-finite mu).
     #[error("{}: {problem}", file.display())]
     Meta {

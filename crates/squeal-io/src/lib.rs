@@ -11,6 +11,9 @@
 //!   `FK.mtx` and the optional index map `T.txt`; the operator at friction coefficient mu
 //!   is `X~ = X_c - mu F_X` (see [`squeal_core::FrictionalOperator`]).
 //!
+//! - [`read_msh`], [`write_msh`]: Gmsh MSH 4.1 ASCII meshes of 8-node hexahedra, physical
+//!   groups becoming named node sets (see [`gmsh`]).
+//!
 //! Every error ([`IoError`]) names the file, the line where one applies, and what was
 //! expected. Units are SI (kg, N s/m, N/m).
 //!
@@ -20,10 +23,12 @@
 #![doc(html_no_source)]
 
 mod error;
+pub mod gmsh;
 mod mtx;
 mod operator;
 
 pub use error::IoError;
+pub use gmsh::{msh_string, read_msh, read_msh_bytes, write_msh, VOLUME_GROUP};
 pub use mtx::{read_mtx, read_mtx_from, read_square_mtx, write_mtx, write_mtx_to};
 pub use operator::{
     read_index_map, read_operator_dir, write_index_map, write_operator_dir, OperatorMeta, FILE_CC,

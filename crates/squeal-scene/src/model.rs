@@ -38,7 +38,8 @@ pub struct SizeRule {
     pub wavelength_m: f64,
     /// Target element edge (m).
     pub element_size_m: f64,
-    /// Elements in each direction (r, theta, z for the disc; x, y, z for blocks).
+    /// Elements in each direction (r, theta, z for the disc; x, y, z for blocks); for an
+    /// imported mesh `[0, 0, 0]` (the disc) or the pin face's `[nx, ny, 0]`.
     pub divisions: [usize; 3],
 }
 
@@ -198,17 +199,25 @@ impl ContactGrid {
     }
 }
 
-/// Pairs each pin face node with the disc face node at the same (x, y) to within
-/// `1e-9` of the patch size; an error lists the unmatched nodes.
-fn contact_grid(mesh: &Mesh, pa: &Patch, file: &str) -> Result<ContactGrid> {
+/// Pairs each node of the pin face (node set `faces[0]`) with the disc face node (set
+/// `faces[1]`) at the same (x, y) to within `1e-9` of the patch size; an error lists the
+/// unmatched nodes, and `named` (empty, or the faces' groups and files) says where they
+/// come from.
+fn contact_grid(
+    mesh: &Mesh,
+    pa: &Patch,
+    faces: [&str; 2],
+    named: &str,
+    file: &str,
+) -> Result<ContactGrid> {
     let size = (pa.xs[pa.xs.len() - 1] - pa.xs[0]).max(pa.ys[pa.ys.len() - 1] - pa.ys[0]);
     let tol = 1e-9 * size;
-    let pin_face = mesh.node_set("pin.zmin").map_err(|m| SceneError::Field {
+    let pin_face = mesh.node_set(faces[0]).map_err(|m| SceneError::Field {
         file: file.into(),
         field: "pin".into(),
         message: m,
     })?;
-    let disc_face = mesh.node_set("disc.zmax").map_err(|m| SceneError::Field {
+    let disc_face = mesh.node_set(faces[1]).map_err(|m| SceneError::Field {
         file: file.into(),
         field: "disc".into(),
         message: m,
@@ -269,9 +278,10 @@ fn contact_grid(mesh: &Mesh, pa: &Patch, file: &str) -> Result<ContactGrid> {
             file: file.into(),
             field: "pin".into(),
             message: format!(
-                "incompatible contact meshes: {} pin face nodes have no disc node within \
-                 {tol:.1e} m in (x, y){}{}",
+                "incompatible contact meshes{named}: {} of {} pin face nodes have no disc \
+                 node within {tol:.1e} m in (x, y){}{}",
                 unmatched.len(),
+                pin_face.len(),
                 if shown.is_empty() {
                     String::new()
                 } else {
@@ -372,7 +382,65 @@ struct Patch {
     step: f64,
 }
 
+/// The grid lines `(xs, ys)` of a face's nodes: their distinct x and y (to `1e-9` of the
+/// face size), checked to form a full tensor grid with one node at each intersection.
+fn face_grid(mesh: &Mesh, face: &[usize]) -> std::result::Result<(Vec<f64>, Vec<f64>), String> {
+    let pts: Vec<[f64; 3]> = face.iter().map(|&n| mesh.nodes[n]).collect();
+    let extent = |a: usize| {
+        let (lo, hi) = pts
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+                (l.min(p[a]), h.max(p[a]))
+            });
+        hi - lo
+    };
+    let tol = 1e-9 * extent(0).max(extent(1));
+    let lines = |a: usize| {
+        let mut v: Vec<f64> = pts.iter().map(|p| p[a]).collect();
+        v.sort_by(f64::total_cmp);
+        let mut out: Vec<f64> = Vec::new();
+        for x in v {
+            if out.last().is_none_or(|&l| x - l > tol) {
+                out.push(x);
+            }
+        }
+        out
+    };
+    let (xs, ys) = (lines(0), lines(1));
+    let find = |v: &[f64], x: f64| v.iter().position(|&l| (l - x).abs() <= tol);
+    let mut hit = vec![0usize; xs.len() * ys.len()];
+    for p in &pts {
+        if let (Some(i), Some(j)) = (find(&xs, p[0]), find(&ys, p[1])) {
+            hit[j * xs.len() + i] += 1;
+        }
+    }
+    let empty = hit.iter().filter(|&&h| h == 0).count();
+    let doubled = hit.iter().filter(|&&h| h > 1).count();
+    if xs.len() < 2 || ys.len() < 2 || empty > 0 || doubled > 0 {
+        return Err(format!(
+            "its {} nodes do not form a full tensor grid in (x, y): {} x-lines x {} y-lines, \
+             {empty} intersections without a node, {doubled} with several; contact zones \
+             need a grid (at least 2 x 2)",
+            pts.len(),
+            xs.len(),
+            ys.len()
+        ));
+    }
+    Ok((xs, ys))
+}
+
 impl Patch {
+    /// The patch of an imported pin face with grid lines `xs`, `ys` (see [`face_grid`]).
+    fn from_grid(xs: Vec<f64>, ys: Vec<f64>) -> Self {
+        let step = xs
+            .windows(2)
+            .chain(ys.windows(2))
+            .map(|w| w[1] - w[0])
+            .fold(f64::INFINITY, f64::min);
+        let yc = 0.5 * (ys[0] + ys[ys.len() - 1]);
+        Patch { xs, ys, yc, step }
+    }
+
     fn new(p: &crate::Pin, n: usize) -> Self {
         let (a, b, yc) = (p.size_x_m, p.size_y_m, p.center_radius_m);
         Patch {
@@ -502,15 +570,105 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
     let mut body_names = Vec::new();
     let mut sizes = Vec::new();
     let mut fixed_nodes: Vec<usize> = Vec::new();
-    // The contact patch under the pin: a Cartesian grid blended into the polar disc.
-    let patch = scene
-        .pin
-        .as_ref()
-        .map(|p| Patch::new(p, rule.pin_face_elements));
+    // Imported meshes: read by Scene::from_file, else now (relative to the working
+    // directory).
+    let import = |imp: Option<&crate::MeshImport>,
+                  field: &str|
+     -> Result<Option<(crate::MeshImport, crate::ImportedMesh)>> {
+        match imp {
+            None => Ok(None),
+            Some(imp) => {
+                let im = match &imp.loaded {
+                    Some(l) => l.clone(),
+                    None => imp.load(None, file, field)?,
+                };
+                Ok(Some((imp.clone(), im)))
+            }
+        }
+    };
+    let disc_import = import(
+        scene.disc.as_ref().and_then(|d| d.mesh.as_ref()),
+        "disc.mesh",
+    )?;
+    let pin_import = import(scene.pin.as_ref().and_then(|p| p.mesh.as_ref()), "pin.mesh")?;
+    let group_field = |body: &str, f: &str, message: String| SceneError::Field {
+        file: file.into(),
+        field: format!("{body}.mesh.{f}"),
+        message,
+    };
+    // The contact patch under the pin: a Cartesian grid blended into the polar disc; the
+    // grid lines of an imported pin's contact group when the scene has a disc.
+    let patch = match (&scene.pin, &pin_import) {
+        (Some(_), Some((imp, im))) if scene.disc.is_some() => {
+            let g = imp.contact_group.as_deref().ok_or_else(|| {
+                group_field(
+                    "pin",
+                    "contact_group",
+                    "expected the pin face's group".into(),
+                )
+            })?;
+            let set = im
+                .mesh
+                .node_set(g)
+                .map_err(|m| group_field("pin", "contact_group", m))?;
+            let (xs, ys) = face_grid(&im.mesh, set).map_err(|m| {
+                group_field(
+                    "pin",
+                    "contact_group",
+                    format!("group `{g}` of {}: {m}", im.path.display()),
+                )
+            })?;
+            Some(Patch::from_grid(xs, ys))
+        }
+        (Some(p), _) => Some(Patch::new(p, rule.pin_face_elements)),
+        (None, _) => None,
+    };
 
-    if which == BodyKind::Disc || (which == BodyKind::All && scene.disc.is_some()) {
+    let disc_built = which == BodyKind::Disc || (which == BodyKind::All && scene.disc.is_some());
+    if let (true, Some((imp, im))) = (disc_built, &disc_import) {
         let d = scene.disc.as_ref().ok_or_else(|| missing("disc"))?;
         let m = mat(&d.material, "disc.material")?;
+        let (lambda, h) = element_size(
+            m.as_ref(),
+            d.thickness_m,
+            rule.max_freq_hz,
+            rule.elements_per_wavelength,
+        );
+        let body = (*im.mesh).clone().with_body(materials.len());
+        let map = mesh.append(&body, "disc.", None);
+        for g in &imp.fixed_groups {
+            let set = body
+                .node_set(g)
+                .map_err(|msg| group_field("disc", "fixed_groups", msg))?;
+            fixed_nodes.extend(set.iter().map(|&n| map[n]));
+        }
+        // the rule's target size, for comparison with the imported elements
+        sizes.push(SizeRule {
+            body: "disc".into(),
+            wavelength_m: lambda,
+            element_size_m: h,
+            divisions: [0; 3],
+        });
+        materials.push(m);
+        body_names.push("disc".to_string());
+    } else if disc_built {
+        let d = scene.disc.as_ref().ok_or_else(|| missing("disc"))?;
+        let m = mat(&d.material, "disc.material")?;
+        if let (Some(pa), Some((_, im))) = (&patch, &pin_import) {
+            let (x0, x1) = (pa.xs[0], pa.xs[pa.xs.len() - 1]);
+            if (x0 + x1).abs() > 1e-9 * (x1 - x0) {
+                return Err(group_field(
+                    "pin",
+                    "contact_group",
+                    format!(
+                        "the generated disc reproduces the pin face centred on x = 0, but the \
+                         pin face of {} spans x in [{x0:e}, {x1:e}] m; centre it on x = 0 or \
+                         import the disc mesh too",
+                        im.path.display()
+                    ),
+                ));
+            }
+        }
         let (lambda, h) = element_size(
             m.as_ref(),
             d.thickness_m,
@@ -640,7 +798,28 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
         body_names.push("disc".to_string());
     }
 
-    if which == BodyKind::Pin || (which == BodyKind::All && scene.pin.is_some()) {
+    let pin_built = which == BodyKind::Pin || (which == BodyKind::All && scene.pin.is_some());
+    if let (true, Some((imp, im))) = (pin_built, &pin_import) {
+        let p = scene.pin.as_ref().ok_or_else(|| missing("pin"))?;
+        let pin_mat = mat(&p.material, "pin.material")?;
+        let body = (*im.mesh).clone().with_body(materials.len());
+        let map = mesh.append(&body, "pin.", None);
+        for g in &imp.fixed_groups {
+            let set = body
+                .node_set(g)
+                .map_err(|msg| group_field("pin", "fixed_groups", msg))?;
+            fixed_nodes.extend(set.iter().map(|&n| map[n]));
+        }
+        let face = patch.as_ref().filter(|_| scene.disc.is_some());
+        sizes.push(SizeRule {
+            body: "pin".into(),
+            wavelength_m: f64::NAN,
+            element_size_m: face.map_or(f64::NAN, |pa| pa.step),
+            divisions: face.map_or([0; 3], |pa| [pa.xs.len() - 1, pa.ys.len() - 1, 0]),
+        });
+        materials.push(pin_mat);
+        body_names.push("pin".into());
+    } else if pin_built {
         let p = scene.pin.as_ref().ok_or_else(|| missing("pin"))?;
         let pin_mat = mat(&p.material, "pin.material")?;
         let (a, b, yc) = (p.size_x_m, p.size_y_m, p.center_radius_m);
@@ -763,7 +942,34 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
     }
 
     let contact = match (&patch, which) {
-        (Some(pa), BodyKind::All) if scene.disc.is_some() => Some(contact_grid(&mesh, pa, file)?),
+        (Some(pa), BodyKind::All) if scene.disc.is_some() => {
+            let face = |body: &str,
+                        import: &Option<(crate::MeshImport, crate::ImportedMesh)>,
+                        generated: &str| match import {
+                Some((imp, im)) => {
+                    let g = imp.contact_group.clone().unwrap_or_default();
+                    (
+                        format!("{body}.{g}"),
+                        format!("group `{g}` of {}", im.path.display()),
+                    )
+                }
+                None => (
+                    format!("{body}.{generated}"),
+                    format!("the generated {body}"),
+                ),
+            };
+            let pin_face = face("pin", &pin_import, "zmin");
+            let disc_face = face("disc", &disc_import, "zmax");
+            let named = (pin_import.is_some() || disc_import.is_some())
+                .then(|| format!(" (pin face: {}; disc face: {})", pin_face.1, disc_face.1));
+            Some(contact_grid(
+                &mesh,
+                pa,
+                [&pin_face.0, &disc_face.0],
+                named.as_deref().unwrap_or(""),
+                file,
+            )?)
+        }
         _ => None,
     };
     fixed_nodes.sort_unstable();

@@ -78,6 +78,144 @@ pub struct Disc {
     pub hat: Option<Hat>,
     /// Material (of ring and hat).
     pub material: MaterialSpec,
+    /// The disc's mesh imported from a Gmsh file instead of generated (optional); the
+    /// dimensions above then only document the disc and place the pin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<MeshImport>,
+}
+
+/// A body mesh read from a Gmsh MSH 4.1 ASCII file of 8-node hexahedra
+/// ([`squeal_io::read_msh`]) instead of generated: `mesh = { file = "disc.msh",
+/// contact_group = "contact", fixed_groups = ["clamp"], scale = 1.0 }`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshImport {
+    /// The file, relative to the scene file's directory.
+    pub file: String,
+    /// Physical group of the contact face: the disc's friction face or the pin face.
+    /// Required when the scene has both a disc and a pin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_group: Option<String>,
+    /// Physical groups whose nodes are fixed (all three DOFs): the Dirichlet faces.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fixed_groups: Vec<String>,
+    /// Factor from the file's length unit to metres (`0.001` for a file in mm).
+    #[serde(default = "unit_scale")]
+    pub scale: f64,
+    /// The mesh as read by [`Scene::from_file`] (scaled to metres); `None` for a scene
+    /// parsed from text, whose file [`build`](crate::build) reads relative to the
+    /// working directory.
+    #[serde(skip)]
+    pub loaded: Option<ImportedMesh>,
+}
+
+fn unit_scale() -> f64 {
+    1.0
+}
+
+/// A mesh read from a [`MeshImport`] file: where from, and the mesh in metres with the
+/// file's physical groups as node sets.
+#[derive(Clone, PartialEq)]
+pub struct ImportedMesh {
+    /// The path read.
+    pub path: std::path::PathBuf,
+    /// The mesh (body 0), coordinates scaled to metres.
+    pub mesh: std::sync::Arc<squeal_fe::Mesh>,
+}
+
+impl std::fmt::Debug for ImportedMesh {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "ImportedMesh({}: {} nodes, {} hexahedra, groups {:?})",
+            self.path.display(),
+            self.mesh.nodes.len(),
+            self.mesh.hexes.len(),
+            self.mesh.node_sets.keys().collect::<Vec<_>>()
+        )
+    }
+}
+
+impl MeshImport {
+    /// Reads the file (relative to `dir`, or as given), scales it to metres and checks
+    /// that every named group exists and holds nodes. `field` (`disc.mesh`, `pin.mesh`)
+    /// and the scene `file` name the place in errors.
+    pub fn load(
+        &self,
+        dir: Option<&std::path::Path>,
+        file: &str,
+        field: &str,
+    ) -> Result<ImportedMesh> {
+        let err = |f: &str, message: String| SceneError::Field {
+            file: file.into(),
+            field: format!("{field}.{f}"),
+            message,
+        };
+        if !(self.scale.is_finite() && self.scale > 0.0) {
+            return Err(err(
+                "scale",
+                format!(
+                    "expected a positive factor from the file's unit to metres, got {}",
+                    self.scale
+                ),
+            ));
+        }
+        let path = match dir {
+            Some(d) => d.join(&self.file),
+            None => std::path::PathBuf::from(&self.file),
+        };
+        if !path.is_file() {
+            return Err(err(
+                "file",
+                format!(
+                    "mesh file `{}` not found; expected a Gmsh MSH 4.1 ASCII file, relative to \
+                     the scene file's directory",
+                    path.display()
+                ),
+            ));
+        }
+        let mut mesh = squeal_io::read_msh(&path).map_err(|e| err("file", e.to_string()))?;
+        for p in mesh.nodes.iter_mut() {
+            p.iter_mut().for_each(|x| *x *= self.scale);
+        }
+        let groups = self
+            .contact_group
+            .iter()
+            .map(|g| ("contact_group", g))
+            .chain(self.fixed_groups.iter().map(|g| ("fixed_groups", g)));
+        for (f, g) in groups {
+            match mesh.node_sets.get(g) {
+                Some(v) if !v.is_empty() => {}
+                found => {
+                    return Err(err(
+                        f,
+                        format!(
+                            "{} `{g}` in {}; available physical groups: {}",
+                            if found.is_some() {
+                                "no hexahedron node in physical group"
+                            } else {
+                                "no physical group"
+                            },
+                            path.display(),
+                            if mesh.node_sets.is_empty() {
+                                "none".to_string()
+                            } else {
+                                mesh.node_sets
+                                    .keys()
+                                    .map(|k| format!("`{k}`"))
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
+                            }
+                        ),
+                    ))
+                }
+            }
+        }
+        Ok(ImportedMesh {
+            path,
+            mesh: std::sync::Arc::new(mesh),
+        })
+    }
 }
 
 /// A hat: a thin cylindrical wall under the disc ring, from `radius_m` (default: the
@@ -110,6 +248,10 @@ pub struct Pin {
     pub height_m: f64,
     /// Material (the pad's, transversely isotropic about z).
     pub material: MaterialSpec,
+    /// The pin's mesh imported from a Gmsh file instead of generated (optional); the
+    /// dimensions above then only document the pin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<MeshImport>,
 }
 
 /// A rectangular plate centred over the pin.
@@ -557,6 +699,13 @@ impl Scene {
             *values = Some(v);
         }
         scene.validate(&file)?;
+        let dir = path.parent().unwrap_or(std::path::Path::new("."));
+        if let Some(imp) = scene.disc.as_mut().and_then(|d| d.mesh.as_mut()) {
+            imp.loaded = Some(imp.load(Some(dir), &file, "disc.mesh")?);
+        }
+        if let Some(imp) = scene.pin.as_mut().and_then(|p| p.mesh.as_mut()) {
+            imp.loaded = Some(imp.load(Some(dir), &file, "pin.mesh")?);
+        }
         Ok(scene)
     }
 
@@ -894,6 +1043,66 @@ impl Scene {
                 }
             }
             _ => {}
+        }
+        let imports = [
+            (
+                "disc.mesh",
+                self.disc.as_ref().and_then(|d| d.mesh.as_ref()),
+            ),
+            ("pin.mesh", self.pin.as_ref().and_then(|p| p.mesh.as_ref())),
+        ];
+        for (name, imp) in imports {
+            let Some(imp) = imp else { continue };
+            if !(imp.scale.is_finite() && imp.scale > 0.0) {
+                return Err(field(
+                    &format!("{name}.scale"),
+                    format!(
+                        "expected a positive factor from the file's unit to metres, got {}",
+                        imp.scale
+                    ),
+                ));
+            }
+            if imp.file.trim().is_empty() {
+                return Err(field(
+                    &format!("{name}.file"),
+                    "expected the path of a Gmsh MSH 4.1 ASCII file".into(),
+                ));
+            }
+            if imp.contact_group.is_none() && self.disc.is_some() && self.pin.is_some() {
+                return Err(field(
+                    &format!("{name}.contact_group"),
+                    "expected the physical group of the contact face: the scene has a disc \
+                     and a pin in contact"
+                        .into(),
+                ));
+            }
+        }
+        if self
+            .disc
+            .as_ref()
+            .is_some_and(|d| d.mesh.is_some() && d.hat.is_some())
+        {
+            return Err(field(
+                "disc.hat",
+                "a hat is generated with the disc: with disc.mesh, mesh the hat in the file \
+                 and remove disc.hat"
+                    .into(),
+            ));
+        }
+        if self.pin.as_ref().is_some_and(|p| p.mesh.is_some()) {
+            for (name, plate) in [
+                ("thin_plate", &self.thin_plate),
+                ("thick_plate", &self.thick_plate),
+            ] {
+                if plate.is_some() {
+                    return Err(field(
+                        name,
+                        "plates are generated on the generated pin's grid: with pin.mesh, \
+                         mesh the plates in the pin's file and remove the plate tables"
+                            .into(),
+                    ));
+                }
+            }
         }
         if self.disc.is_none() && self.pin.is_none() {
             return Err(field(
