@@ -116,6 +116,32 @@ const CORNER_EDGES: [[usize; 3]; 8] = [
     [6, 4, 3],
 ];
 
+/// The 12 edges of a hexahedron as corner pairs (bottom face, top face, verticals).
+pub const EDGES: [(usize, usize); 12] = [
+    (0, 1),
+    (1, 2),
+    (2, 3),
+    (3, 0),
+    (4, 5),
+    (5, 6),
+    (6, 7),
+    (7, 4),
+    (0, 4),
+    (1, 5),
+    (2, 6),
+    (3, 7),
+];
+
+/// Lengths of the 12 [`EDGES`] of a hexahedron with corners `x`.
+pub fn edge_lengths(x: &[[f64; 3]; 8]) -> [f64; 12] {
+    EDGES.map(|(a, c)| {
+        (0..3)
+            .map(|k| (x[a][k] - x[c][k]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    })
+}
+
 /// Element matrices of one hexahedron.
 #[derive(Debug, Clone)]
 pub struct Hex8Matrices {

@@ -494,28 +494,9 @@ pub fn read_msh_bytes(bytes: &[u8], file: &Path) -> Result<Mesh, IoError> {
             }
             let x = h.map(|n| mesh.nodes[n]);
             let vol = hex_volume(&x);
-            let edge = [
-                (0, 1),
-                (1, 2),
-                (2, 3),
-                (3, 0),
-                (4, 5),
-                (5, 6),
-                (6, 7),
-                (7, 4),
-                (0, 4),
-                (1, 5),
-                (2, 6),
-                (3, 7),
-            ]
-            .iter()
-            .map(|&(a, c)| {
-                (0..3)
-                    .map(|k| (x[a][k] - x[c][k]).powi(2))
-                    .sum::<f64>()
-                    .sqrt()
-            })
-            .fold(0.0, f64::max);
+            let edge = squeal_fe::hex8::edge_lengths(&x)
+                .into_iter()
+                .fold(0.0, f64::max);
             if vol.is_nan() || vol.abs() <= 1e-12 * edge.powi(3) {
                 return Err(p.err(
                     Some(*line),

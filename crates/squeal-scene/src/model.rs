@@ -107,24 +107,7 @@ impl Model {
             st.min_scaled_jacobian = st
                 .min_scaled_jacobian
                 .min(squeal_fe::hex8::scaled_jacobian(&x));
-            for (a, c) in [
-                (0, 1),
-                (1, 2),
-                (2, 3),
-                (3, 0),
-                (4, 5),
-                (5, 6),
-                (6, 7),
-                (7, 4),
-                (0, 4),
-                (1, 5),
-                (2, 6),
-                (3, 7),
-            ] {
-                let l = (0..3)
-                    .map(|k| (x[a][k] - x[c][k]).powi(2))
-                    .sum::<f64>()
-                    .sqrt();
+            for l in squeal_fe::hex8::edge_lengths(&x) {
                 st.edge_range_m = (st.edge_range_m.0.min(l), st.edge_range_m.1.max(l));
             }
             for &n in h {
