@@ -77,6 +77,7 @@ pub fn info(registry: &Registry, scene: &Scene, file: &str) -> Result<()> {
             );
         }
     }
+    println!("\ndamping: {}", scene.damping.describe());
     match &model.contact {
         Some(c) => println!(
             "\ncontact: {} node-to-node pairs ({} x {} grid, step {:.3} mm), max (x, y) mismatch {:.1e} m",

@@ -36,6 +36,9 @@ pub struct StabilityReport {
     pub unstable_tol: f64,
     pub active_pairs: Option<usize>,
     pub pairs: Option<usize>,
+    /// The scene's damping (`none`, or its Rayleigh coefficients and contact dashpots), or
+    /// whether an operator directory has a damping part.
+    pub damping: String,
     pub equilibrium_time_s: f64,
     pub operator_time_s: f64,
     pub solve_time_s: f64,
@@ -70,6 +73,7 @@ pub struct Source {
     pub mu: f64,
     pub active_pairs: Option<usize>,
     pub pairs: Option<usize>,
+    pub damping: String,
     pub equilibrium_time_s: f64,
     pub operator_time_s: f64,
 }
@@ -83,12 +87,18 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
         let op = read_operator_any(dir)?;
         let mu = a.mu.context("--mu is required with --operator")?;
         squeal_contact::check_user_mu(mu)?;
+        let damping = if op.cc.is_some() || op.fc.is_some() {
+            "read from the operator files (C_c, F_C)".into()
+        } else {
+            "none".into()
+        };
         return Ok(Source {
             name: dir.display().to_string(),
             op,
             mu,
             active_pairs: None,
             pairs: None,
+            damping,
             equilibrium_time_s: 0.0,
             operator_time_s: start.elapsed().as_secs_f64(),
         });
@@ -107,6 +117,7 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
         mu,
         active_pairs: Some(eq.eq.active.iter().filter(|&&x| x).count()),
         pairs: Some(prep.set.len()),
+        damping: prep.scene.damping.describe(),
         equilibrium_time_s,
         operator_time_s: t1.elapsed().as_secs_f64(),
     })
@@ -155,6 +166,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
         unstable_tol: a.unstable_tol,
         active_pairs: src.active_pairs,
         pairs: src.pairs,
+        damping: src.damping,
         equilibrium_time_s: src.equilibrium_time_s,
         operator_time_s: src.operator_time_s,
         solve_time_s: modes.info.time_s,
@@ -190,6 +202,9 @@ pub fn print(r: &StabilityReport) {
     );
     if let (Some(a), Some(p)) = (r.active_pairs, r.pairs) {
         println!("contact: {a} of {p} pairs active");
+    }
+    if r.damping != "none" {
+        println!("damping: {}", r.damping);
     }
     println!(
         "{:>4} {:>12} {:>14} {:>12} {:>9} {:>10}",

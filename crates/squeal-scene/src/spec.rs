@@ -576,6 +576,30 @@ impl Damping {
         self.contact_tangential_n_s_per_m3.unwrap_or(0.0)
     }
 
+    /// One line for reports: `none`, or the Rayleigh coefficients and the contact
+    /// dashpots with their units.
+    pub fn describe(&self) -> String {
+        if self.is_zero() {
+            return "none".into();
+        }
+        let (a, b) = self.rayleigh();
+        let mut parts = Vec::new();
+        if a != 0.0 || b != 0.0 {
+            let from = match (self.rayleigh_ratio, self.rayleigh_freqs_hz) {
+                (Some(z), Some([f1, f2])) => format!(" (ratio {z} at {f1} and {f2} Hz)"),
+                _ => String::new(),
+            };
+            parts.push(format!(
+                "Rayleigh alpha = {a:.6e} 1/s, beta = {b:.6e} s{from}"
+            ));
+        }
+        let c = self.contact_tangential();
+        if c != 0.0 {
+            parts.push(format!("contact tangential {c:e} N s/m^3"));
+        }
+        parts.join("; ")
+    }
+
     /// Whether the damping matrix is zero.
     pub fn is_zero(&self) -> bool {
         let (a, b) = self.rayleigh();

@@ -342,6 +342,12 @@ fn damping_is_parsed_checked_and_written_back() {
     }
     assert!(zeta(3000.0) < 0.01);
     assert_eq!(s.damping.contact_tangential(), 2.5e4);
+    assert_eq!(base.damping.describe(), "none");
+    let line = s.damping.describe();
+    assert!(
+        line.contains("1/s") && line.contains("ratio 0.01") && line.contains("2.5e4 N s/m^3"),
+        "{line}"
+    );
     assert_eq!(Scene::from_toml(&s.to_toml(), "again").unwrap(), s);
     let cases = [
         (
