@@ -3,18 +3,21 @@
 //! thickness, hat radius) to the paper's Table 2.
 //!
 //! Run: `cargo run --release --example disc_fit -- [r_in R h hat_height hat_wall hat_radius]`
+//! With `SQUEAL_FIT_FAMILY=flange` the hat's lower end is closed by an annular plate
+//! clamped at its bore (a bolted hub flange), two more parameters:
+//! `-- [r_in R h hat_height hat_wall hat_radius flange_bore flange_thickness]`.
 //! Objective: sum over the 16 labels of (log f_squeal - log f_paper)^2, a missing label
 //! costing (log 1.5)^2; the pin face (radii 0.09 to 0.11 m) must stay on the ring.
 //! `SQUEAL_FIT_EVAL=1` only evaluates the given point. Set `SQUEAL_FIT_EPW` to change elements per wavelength during the search (default 10).
 
 use squeal::analysis::modal::{compare_table2, format_table, normal_modes};
 use squeal::core::{EigenParams, Params};
-use squeal::scene::{build, BodyKind, Hat, Scene};
+use squeal::scene::{build, BodyKind, Flange, Hat, Scene};
 
-const N: usize = 6;
-
-fn cost(x: &[f64; N], epw: f64, verbose: bool) -> f64 {
-    let [ri, r, h, hh, th, rh] = *x;
+/// The disc of parameter vector `x` (6 values: ring and hat; 8: plus the flange), `None`
+/// when infeasible.
+fn disc_scene(x: &[f64], epw: f64) -> Option<Scene> {
+    let (ri, r, h, hh, th, rh) = (x[0], x[1], x[2], x[3], x[4], x[5]);
     if !(0.01..=0.088).contains(&ri)
         || r < 0.12
         || h < 0.004
@@ -23,9 +26,16 @@ fn cost(x: &[f64; N], epw: f64, verbose: bool) -> f64 {
         || rh < ri
         || rh + th > 0.088
     {
-        return 1e3;
+        return None;
     }
-    let reg = squeal::registry();
+    let flange = match x[6..] {
+        [rf, tf] if rf > 0.005 && rf < rh - 0.002 && tf >= 0.001 => Some(Flange {
+            inner_radius_m: rf,
+            thickness_m: tf,
+        }),
+        [] => None,
+        _ => return None,
+    };
     let mut scene = Scene::builtin("pin-on-disc").unwrap();
     scene.mesh.elements_per_wavelength = epw;
     let d = scene.disc.as_mut().unwrap();
@@ -34,7 +44,16 @@ fn cost(x: &[f64; N], epw: f64, verbose: bool) -> f64 {
         radius_m: Some(rh),
         height_m: hh,
         thickness_m: th,
+        flange,
     });
+    Some(scene)
+}
+
+fn cost(x: &[f64], epw: f64, verbose: bool) -> f64 {
+    let Some(scene) = disc_scene(x, epw) else {
+        return 1e3;
+    };
+    let reg = squeal::registry();
     let model = build(&scene, BodyKind::Disc, &reg, "fit").unwrap();
     let solver = reg.eigen.create("arpack", &Params::new()).unwrap();
     let params = EigenParams {
@@ -44,6 +63,13 @@ fn cost(x: &[f64; N], epw: f64, verbose: bool) -> f64 {
     };
     let (_, modes) = normal_modes(&model, solver.as_ref(), &params).unwrap();
     let rows = compare_table2(&modes);
+    let within5 = rows
+        .iter()
+        .filter(|r| {
+            r.squeal_hz
+                .is_some_and(|f| (f / r.paper_hz - 1.0).abs() <= 0.05)
+        })
+        .count();
     let c: f64 = rows
         .iter()
         .map(|r| {
@@ -54,7 +80,10 @@ fn cost(x: &[f64; N], epw: f64, verbose: bool) -> f64 {
     if verbose {
         print!("{}", format_table(&rows));
     }
-    println!("x = {x:.4?} -> cost {c:.5} ({} DOFs)", model.dofs.n_free());
+    println!(
+        "x = {x:.4?} -> cost {c:.5}, {within5}/16 within 5 % ({} DOFs)",
+        model.dofs.n_free()
+    );
     c
 }
 
@@ -67,48 +96,53 @@ fn main() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(10.0);
-    let x0: [f64; N] = if args.len() == N {
-        std::array::from_fn(|i| args[i])
-    } else {
-        [0.07, 0.15, 0.02, 0.03, 0.004, 0.07]
+    let flange = std::env::var("SQUEAL_FIT_FAMILY").is_ok_and(|f| f == "flange");
+    let x0: Vec<f64> = match (flange, args.len()) {
+        (false, 6) | (true, 8) => args,
+        (false, _) => vec![0.07, 0.15, 0.02, 0.03, 0.004, 0.07],
+        (true, _) => vec![0.0671, 0.1501, 0.015, 0.0242, 0.0049, 0.0671, 0.04, 0.006],
     };
+    let n = x0.len();
+    let f = |x: &[f64]| cost(x, epw, false);
     if std::env::var("SQUEAL_FIT_EVAL").is_ok() {
         cost(&x0, epw, true);
         return;
     }
-    let mut simplex: Vec<([f64; N], f64)> = (0..=N)
+    let mut simplex: Vec<(Vec<f64>, f64)> = (0..=n)
         .map(|i| {
-            let mut x = x0;
+            let mut x = x0.clone();
             if i > 0 {
                 x[i - 1] *= 1.15;
             }
-            (x, cost(&x, epw, false))
+            let c = f(&x);
+            (x, c)
         })
         .collect();
     for _ in 0..150 {
         simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
-        let c: [f64; N] =
-            std::array::from_fn(|k| simplex[..N].iter().map(|s| s.0[k]).sum::<f64>() / N as f64);
-        let w = simplex[N];
-        let at = |t: f64| -> [f64; N] { std::array::from_fn(|k| c[k] + t * (w.0[k] - c[k])) };
+        let c: Vec<f64> = (0..n)
+            .map(|k| simplex[..n].iter().map(|s| s.0[k]).sum::<f64>() / n as f64)
+            .collect();
+        let w = simplex[n].clone();
+        let at = |t: f64| -> Vec<f64> { (0..n).map(|k| c[k] + t * (w.0[k] - c[k])).collect() };
         let r = at(-1.0);
-        let fr = cost(&r, epw, false);
+        let fr = f(&r);
         if fr < simplex[0].1 {
             let e = at(-2.0);
-            let fe = cost(&e, epw, false);
-            simplex[N] = if fe < fr { (e, fe) } else { (r, fr) };
-        } else if fr < simplex[N - 1].1 {
-            simplex[N] = (r, fr);
+            let fe = f(&e);
+            simplex[n] = if fe < fr { (e, fe) } else { (r, fr) };
+        } else if fr < simplex[n - 1].1 {
+            simplex[n] = (r, fr);
         } else {
             let k = at(0.5);
-            let fk = cost(&k, epw, false);
+            let fk = f(&k);
             if fk < w.1 {
-                simplex[N] = (k, fk);
+                simplex[n] = (k, fk);
             } else {
-                let best = simplex[0].0;
+                let best = simplex[0].0.clone();
                 for s in simplex.iter_mut().skip(1) {
-                    s.0 = std::array::from_fn(|k| best[k] + 0.5 * (s.0[k] - best[k]));
-                    s.1 = cost(&s.0, epw, false);
+                    s.0 = (0..n).map(|k| best[k] + 0.5 * (s.0[k] - best[k])).collect();
+                    s.1 = f(&s.0);
                 }
             }
         }

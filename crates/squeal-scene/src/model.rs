@@ -759,7 +759,34 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
                 )
                 .with_body(body);
                 let hmap = mesh.append(&hat_mesh, "disc.hat.", Some(1e-9 * d.outer_radius_m));
-                fixed_nodes.extend(hat_mesh.node_set("zmin").unwrap().iter().map(|&n| hmap[n]));
+                match &hat.flange {
+                    None => fixed_nodes
+                        .extend(hat_mesh.node_set("zmin").unwrap().iter().map(|&n| hmap[n])),
+                    Some(fl) => {
+                        // an annular plate under the wall, inward to its clamped bore
+                        let z0 = -d.thickness_m - hat.height_m;
+                        let (_, hf) = element_size(
+                            m.as_ref(),
+                            fl.thickness_m,
+                            rule.max_freq_hz,
+                            rule.elements_per_wavelength,
+                        );
+                        let mut frs = graded(&[fl.inner_radius_m, r_in_wall], &|_, _| hf.min(h));
+                        frs.extend(wall_rs.iter().skip(1));
+                        let nzf = ((fl.thickness_m / hf).ceil() as usize).max(rule.min_layers);
+                        let flange = Mesh::annulus_mapped(
+                            &frs,
+                            &thetas,
+                            &squeal_fe::mesh::linspace(z0 - fl.thickness_m, z0, nzf),
+                            &xy_map,
+                        )
+                        .with_body(body);
+                        let fmap =
+                            mesh.append(&flange, "disc.hat.flange.", Some(1e-9 * d.outer_radius_m));
+                        fixed_nodes
+                            .extend(flange.node_set("inner").unwrap().iter().map(|&n| fmap[n]));
+                    }
+                }
                 divisions[2] += nzh;
                 hat_rule = Some(SizeRule {
                     body: "disc hat".into(),

@@ -232,6 +232,21 @@ pub struct Hat {
     pub height_m: f64,
     /// Wall thickness (m), less than the ring's radial width.
     pub thickness_m: f64,
+    /// An annular plate closing the wall's lower end, clamped at its bore (a bolted hub
+    /// flange); absent: the wall's lower end is clamped.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flange: Option<Flange>,
+}
+
+/// The hat's bottom plate: from the wall inward to `inner_radius_m`, where it is
+/// clamped, `thickness_m` thick, under the wall.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Flange {
+    /// Bore radius (m), where the flange is clamped; less than the wall's inner radius.
+    pub inner_radius_m: f64,
+    /// Plate thickness (m).
+    pub thickness_m: f64,
 }
 
 /// The pin: a rectangular block standing on the disc's friction face.
@@ -795,6 +810,19 @@ impl Scene {
                             d.outer_radius_m
                         ),
                     ));
+                }
+                if let Some(fl) = &hat.flange {
+                    positive("disc.hat.flange.inner_radius_m", fl.inner_radius_m)?;
+                    positive("disc.hat.flange.thickness_m", fl.thickness_m)?;
+                    if fl.inner_radius_m >= r0 {
+                        return Err(field(
+                            "disc.hat.flange.inner_radius_m",
+                            format!(
+                                "expected less than the wall's inner radius {r0} m, got {}",
+                                fl.inner_radius_m
+                            ),
+                        ));
+                    }
                 }
                 if hat.thickness_m >= d.outer_radius_m - d.inner_radius_m {
                     return Err(field(

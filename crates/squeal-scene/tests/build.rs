@@ -401,3 +401,32 @@ fn tributary_areas_cover_the_pin_face() {
     let min = areas.iter().cloned().fold(f64::INFINITY, f64::min);
     approx::assert_relative_eq!(min * 4.0, max, max_relative = 1e-9);
 }
+
+#[test]
+fn hat_flange_is_glued_under_the_wall_and_clamped_at_its_bore() {
+    let mut scene = Scene::builtin("pin-on-disc").unwrap();
+    let plain = build(&scene, BodyKind::Disc, &registry(), "hat").unwrap();
+    let d = scene.disc.as_mut().unwrap();
+    let hat = d.hat.as_mut().unwrap();
+    let (r0, tf, rf) = (hat.radius_m.unwrap_or(d.inner_radius_m), 0.006, 0.04);
+    let r1 = r0 + hat.thickness_m;
+    hat.flange = Some(squeal_scene::Flange {
+        inner_radius_m: rf,
+        thickness_m: tf,
+    });
+    let model = build(&scene, BodyKind::Disc, &registry(), "flange").unwrap();
+    // the flange adds its annulus (rf to the wall's outer radius) of mass
+    let added = 7850.0 * std::f64::consts::PI * (r1 * r1 - rf * rf) * tf;
+    let rel = (model.total_mass - plain.total_mass) / added - 1.0;
+    assert!((-3e-3..=0.0).contains(&rel), "flange mass error {rel:e}");
+    // glued: the wall's lower nodes are flange nodes, not duplicates
+    let wall_bottom = model.mesh.node_set("disc.hat.zmin").unwrap();
+    let flange_top = model.mesh.node_set("disc.hat.flange.zmax").unwrap();
+    assert!(wall_bottom.iter().all(|n| flange_top.contains(n)));
+    // clamped at the bore only: the wall's lower end is free now
+    let bore = model.mesh.node_set("disc.hat.flange.inner").unwrap().len();
+    assert_eq!(model.dofs.n_free(), 3 * (model.mesh.n_nodes() - bore));
+    let bad = scene.to_toml().replace("inner_radius_m = 0.04", "inner_radius_m = 0.09");
+    let e = Scene::from_toml(&bad, "bad.toml").unwrap_err().to_string();
+    assert!(e.contains("disc.hat.flange.inner_radius_m"), "{e}");
+}
