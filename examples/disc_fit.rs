@@ -8,7 +8,9 @@
 //! `-- [r_in R h hat_height hat_wall hat_radius flange_bore flange_thickness]`.
 //! Objective: sum over the 16 labels of (log f_squeal - log f_paper)^2, a missing label
 //! costing (log 1.5)^2; the pin face (radii 0.09 to 0.11 m) must stay on the ring.
-//! `SQUEAL_FIT_EVAL=1` only evaluates the given point. Set `SQUEAL_FIT_EPW` to change elements per wavelength during the search (default 10).
+//! `SQUEAL_FIT_COST=hinge` weighs misfits beyond 4 % 100x instead (the acceptance's shape).
+//! `SQUEAL_FIT_EVAL=1` only evaluates the given point. `SQUEAL_FIT_EPW` sets the elements
+//! per wavelength during the search (default 10).
 
 use squeal::analysis::modal::{compare_table2, format_table, normal_modes};
 use squeal::core::{EigenParams, Params};
@@ -70,11 +72,20 @@ fn cost(x: &[f64], epw: f64, verbose: bool) -> f64 {
                 .is_some_and(|f| (f / r.paper_hz - 1.0).abs() <= 0.05)
         })
         .count();
+    // log least squares, or (SQUEAL_FIT_COST=hinge) the acceptance's shape: misfits
+    // beyond 4 % weigh 100x, with a light pull towards the paper inside
+    let hinge = std::env::var("SQUEAL_FIT_COST").is_ok_and(|c| c == "hinge");
     let c: f64 = rows
         .iter()
         .map(|r| {
-            r.squeal_hz
-                .map_or(1.5f64.ln().powi(2), |f| (f / r.paper_hz).ln().powi(2))
+            let e = r
+                .squeal_hz
+                .map_or(1.5f64.ln(), |f| (f / r.paper_hz).ln().abs());
+            if hinge {
+                100.0 * (e - 0.04).max(0.0).powi(2) + 0.01 * e * e
+            } else {
+                e * e
+            }
         })
         .sum();
     if verbose {

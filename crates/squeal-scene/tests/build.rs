@@ -426,7 +426,9 @@ fn hat_flange_is_glued_under_the_wall_and_clamped_at_its_bore() {
     // clamped at the bore only: the wall's lower end is free now
     let bore = model.mesh.node_set("disc.hat.flange.inner").unwrap().len();
     assert_eq!(model.dofs.n_free(), 3 * (model.mesh.n_nodes() - bore));
-    let bad = scene.to_toml().replace("inner_radius_m = 0.04", "inner_radius_m = 0.09");
+    let bad = scene
+        .to_toml()
+        .replace("inner_radius_m = 0.04", "inner_radius_m = 0.09");
     let e = Scene::from_toml(&bad, "bad.toml").unwrap_err().to_string();
     assert!(e.contains("disc.hat.flange.inner_radius_m"), "{e}");
 }
