@@ -8,7 +8,7 @@
 //!   basis agree on the damped operator, heavily damped roots (damping ratio above `1/sqrt 2`) dropped by
 //!   both.
 
-use squeal::analysis::pipeline::{scene_operator, Prepared};
+use squeal::analysis::pipeline::{damped_operator, Prepared};
 use squeal::core::qep::ComplexModes;
 use squeal::core::{EigenParams, FrictionalOperator, Params};
 use squeal::scene::{Damping, Scene};
@@ -49,13 +49,7 @@ fn rayleigh_damping_is_proportional_damping_without_friction() {
     });
     let op = prep.operator(&active).unwrap();
     assert!(op.cc.is_some() && op.fc.is_some());
-    let undamped = scene_operator(
-        &prep.model,
-        &Scene::builtin("pin-on-disc-coarse").unwrap(),
-        &prep.set,
-        &active,
-    )
-    .unwrap();
+    let undamped = damped_operator(&prep.model, &Damping::default(), &prep.set, &active).unwrap();
     assert!(undamped.cc.is_none());
     let free = solve("dense", &undamped, 0.0);
     // (`dense` on the damped companion form is checked against `arpack` below)

@@ -9,7 +9,7 @@ use squeal_contact::{
 use squeal_core::contact::Condensation;
 use squeal_core::qep::ComplexModes;
 use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Params, Registry};
-use squeal_scene::{build, BodyKind, Model, Scene, SceneError};
+use squeal_scene::{build, BodyKind, Damping, Model, Scene, SceneError};
 use std::time::Instant;
 use thiserror::Error;
 
@@ -116,19 +116,19 @@ impl Prepared {
 
     /// The frictional operator of an active set, with the scene's damping.
     pub fn operator(&self, active: &[bool]) -> Result<FrictionalOperator> {
-        scene_operator(&self.model, &self.scene, &self.set, active)
+        damped_operator(&self.model, &self.scene.damping, &self.set, active)
     }
 }
 
 /// The frictional operator of the closed pairs `active` of `set` on `model`, damped as
-/// `scene.damping` says (see [`squeal_contact::damping`]).
-pub fn scene_operator(
+/// `damping` says (see [`squeal_contact::damping`]).
+pub fn damped_operator(
     model: &Model,
-    scene: &Scene,
+    damping: &Damping,
     set: &ContactSet,
     active: &[bool],
 ) -> Result<FrictionalOperator> {
-    let c = damping_matrix(model, set, active, &scene.damping)?;
+    let c = damping_matrix(model, set, active, damping)?;
     Ok(build_operator(
         model.m.as_ref(),
         c.as_ref().map(|c| c.as_ref()),

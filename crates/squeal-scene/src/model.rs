@@ -277,6 +277,24 @@ fn contact_grid(
     Ok(grid)
 }
 
+/// Appends an imported body mesh as body `body` (node sets prefixed `prefix`) and fixes
+/// the nodes of its `fixed_groups`; an unknown group is an error message.
+fn append_imported(
+    mesh: &mut Mesh,
+    fixed_nodes: &mut Vec<usize>,
+    im: &crate::ImportedMesh,
+    fixed_groups: &[String],
+    body: usize,
+    prefix: &str,
+) -> std::result::Result<(), String> {
+    let part = (*im.mesh).clone().with_body(body);
+    let map = mesh.append(&part, prefix, None);
+    for g in fixed_groups {
+        fixed_nodes.extend(part.node_set(g)?.iter().map(|&n| map[n]));
+    }
+    Ok(())
+}
+
 /// Bending-wave element size for a plate of `thickness` made of `mat` at `freq_hz`.
 pub fn element_size(
     mat: &dyn Material,
@@ -617,14 +635,15 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             rule.max_freq_hz,
             rule.elements_per_wavelength,
         );
-        let body = (*im.mesh).clone().with_body(materials.len());
-        let map = mesh.append(&body, "disc.", None);
-        for g in &imp.fixed_groups {
-            let set = body
-                .node_set(g)
-                .map_err(|msg| group_field("disc", "fixed_groups", msg))?;
-            fixed_nodes.extend(set.iter().map(|&n| map[n]));
-        }
+        append_imported(
+            &mut mesh,
+            &mut fixed_nodes,
+            im,
+            &imp.fixed_groups,
+            materials.len(),
+            "disc.",
+        )
+        .map_err(|msg| group_field("disc", "fixed_groups", msg))?;
         // the rule's target size, for comparison with the imported elements
         sizes.push(SizeRule {
             body: "disc".into(),
@@ -812,14 +831,15 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
     if let (true, Some((imp, im))) = (pin_built, &pin_import) {
         let p = scene.pin.as_ref().ok_or_else(|| missing("pin"))?;
         let pin_mat = mat(&p.material, "pin.material")?;
-        let body = (*im.mesh).clone().with_body(materials.len());
-        let map = mesh.append(&body, "pin.", None);
-        for g in &imp.fixed_groups {
-            let set = body
-                .node_set(g)
-                .map_err(|msg| group_field("pin", "fixed_groups", msg))?;
-            fixed_nodes.extend(set.iter().map(|&n| map[n]));
-        }
+        append_imported(
+            &mut mesh,
+            &mut fixed_nodes,
+            im,
+            &imp.fixed_groups,
+            materials.len(),
+            "pin.",
+        )
+        .map_err(|msg| group_field("pin", "fixed_groups", msg))?;
         let face = patch.as_ref().filter(|_| scene.disc.is_some());
         sizes.push(SizeRule {
             body: "pin".into(),

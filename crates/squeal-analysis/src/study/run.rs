@@ -4,9 +4,9 @@
 use super::summary::{summarize, Summary, TimingSummary};
 use super::{files, input, Case, CaseList, Result, Shard, SolveSpec, StudyDef, StudyError};
 use crate::jsonl;
-use crate::pipeline::{Method, PipelineError};
+use crate::pipeline::{damped_operator, Method, PipelineError};
 use serde::{Deserialize, Serialize};
-use squeal_contact::{build_operator, damping_matrix, ContactSet};
+use squeal_contact::ContactSet;
 use squeal_core::Registry;
 use squeal_scene::{Damping, Model};
 use std::path::{Path, PathBuf};
@@ -111,15 +111,7 @@ pub fn run_case(
         let set = ContactSet::new(model, &case.zone, rotation)?;
         t.contact_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
-        let active = vec![true; set.len()];
-        let c = damping_matrix(model, &set, &active, damping)?;
-        let op = build_operator(
-            model.m.as_ref(),
-            c.as_ref().map(|c| c.as_ref()),
-            model.k.as_ref(),
-            &set,
-            &active,
-        )?;
+        let op = damped_operator(model, damping, &set, &vec![true; set.len()])?;
         t.operator_s = t1.elapsed().as_secs_f64();
         let (modes, basis_size, _) = method.solve(&op, case.mu, true)?;
         let st = method.last_times();
