@@ -370,6 +370,32 @@ fn within(v: &[f64], lo: f64, hi: f64) -> Vec<f64> {
         .collect()
 }
 
+/// Makes `edge` a line of the increasing grid `v`: the nearest line outside the contact
+/// grid `fixed` moves onto it when that keeps the neighbouring elements at least 40 % of
+/// their former size, otherwise a new line is inserted.
+fn insert_edge(v: &mut Vec<f64>, fixed: &[f64], edge: f64) {
+    let eps = 1e-12 * (1.0 + edge.abs());
+    let i = v.partition_point(|&x| x < edge);
+    let near = [i.checked_sub(1), (i < v.len()).then_some(i)]
+        .into_iter()
+        .flatten()
+        .min_by(|&a, &b| (v[a] - edge).abs().total_cmp(&(v[b] - edge).abs()));
+    let Some(j) = near else { return };
+    if (v[j] - edge).abs() <= eps {
+        return;
+    }
+    let (lo, hi) = (fixed[0] - eps, fixed[fixed.len() - 1] + eps);
+    let movable = (v[j] < lo || v[j] > hi) && j > 0 && j + 1 < v.len();
+    if movable {
+        let (a, b) = (v[j - 1], v[j + 1]);
+        if edge - a >= 0.4 * (v[j] - a) && b - edge >= 0.4 * (b - v[j]) {
+            v[j] = edge;
+            return;
+        }
+    }
+    v.insert(i, edge);
+}
+
 /// The contact patch: the pin face's Cartesian grid `xs x ys` (sliding direction x,
 /// radius y), which the disc mesh reproduces exactly under the pin.
 struct Patch {
@@ -903,8 +929,16 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             }
             v
         };
-        let xs = around(&pa.xs, -lx / 2.0, lx / 2.0);
-        let ys = around(&pa.ys, yc - ly / 2.0, yc + ly / 2.0);
+        let mut xs = around(&pa.xs, -lx / 2.0, lx / 2.0);
+        let mut ys = around(&pa.ys, yc - ly / 2.0, yc + ly / 2.0);
+        // every plate's own edges are grid lines, so a plate smaller than the largest
+        // keeps its true size
+        for (_, pl) in &plates {
+            insert_edge(&mut xs, &pa.xs, -pl.length_x_m / 2.0);
+            insert_edge(&mut xs, &pa.xs, pl.length_x_m / 2.0);
+            insert_edge(&mut ys, &pa.ys, yc - pl.width_y_m / 2.0);
+            insert_edge(&mut ys, &pa.ys, yc + pl.width_y_m / 2.0);
+        }
         // through the pin height: the face step at the contact, graded up to the size the
         // band needs in the pad material
         let (_, h_pin_z) = element_size(

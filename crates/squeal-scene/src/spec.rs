@@ -304,10 +304,10 @@ impl Default for MeshRule {
     fn default() -> Self {
         Self {
             max_freq_hz: 10_500.0,
-            elements_per_wavelength: 10.0,
-            min_layers: 2,
+            elements_per_wavelength: 15.0,
+            min_layers: 3,
             pin_face_elements: 20,
-            grading_ratio: 1.5,
+            grading_ratio: 1.25,
         }
     }
 }

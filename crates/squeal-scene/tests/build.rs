@@ -432,3 +432,44 @@ fn hat_flange_is_glued_under_the_wall_and_clamped_at_its_bore() {
     let e = Scene::from_toml(&bad, "bad.toml").unwrap_err().to_string();
     assert!(e.contains("disc.hat.flange.inner_radius_m"), "{e}");
 }
+
+/// The plates keep their own sizes (each plate's edges are grid lines of the shared
+/// in-plane grid): the pin stack's mass is the sum of the three blocks' masses.
+#[test]
+fn plates_keep_their_sizes_in_the_shared_grid() {
+    let base = Scene::builtin("pin-on-disc").unwrap();
+    for (lx, wy) in [
+        (0.040, 0.040),
+        (0.033, 0.027),
+        (0.040, 0.022),
+        (0.021, 0.03),
+    ] {
+        let mut scene = base.clone();
+        scene.thick_plate.as_mut().unwrap().length_x_m = lx;
+        scene.thick_plate.as_mut().unwrap().width_y_m = wy;
+        let model = build(&scene, BodyKind::Pin, &registry(), "plates").unwrap();
+        let rho = |m: &squeal_scene::MaterialSpec| m.constants["density_kg_m3"].as_float().unwrap();
+        let p = scene.pin.as_ref().unwrap();
+        let (tp, kp) = (
+            scene.thin_plate.as_ref().unwrap(),
+            scene.thick_plate.as_ref().unwrap(),
+        );
+        let expected = rho(&p.material) * p.size_x_m * p.size_y_m * p.height_m
+            + rho(&tp.material) * tp.length_x_m * tp.width_y_m * tp.thickness_m
+            + rho(&kp.material) * kp.length_x_m * kp.width_y_m * kp.thickness_m;
+        assert!(
+            (model.total_mass - expected).abs() <= 1e-9 * expected,
+            "thick plate {lx} x {wy} m: mass {} kg, expected {expected} kg",
+            model.total_mass
+        );
+        let min_sj = model
+            .body_stats()
+            .iter()
+            .map(|b| b.min_scaled_jacobian)
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            min_sj > 0.99,
+            "thick plate {lx} x {wy} m: min scaled Jacobian {min_sj}"
+        );
+    }
+}
