@@ -12,7 +12,9 @@
 //! instead (the acceptance's shape).
 //! `SQUEAL_FIT_EVAL=1` only evaluates the given point. The search meshes the disc with the
 //! default scene's size rule; `SQUEAL_FIT_EPW`, `SQUEAL_FIT_LAYERS` and `SQUEAL_FIT_GRADING`
-//! override its elements per wavelength, minimum layers and grading ratio.
+//! override its elements per wavelength, minimum layers and grading ratio;
+//! `SQUEAL_FIT_CORRECT=1` then scales each label by its default-rule / search-rule ratio
+//! at the starting point (a coarse search that aims at the default mesh's frequencies).
 
 use squeal::analysis::modal::{compare_table2, format_table, normal_modes, TableRow};
 use squeal::core::{EigenParams, Params};
@@ -52,8 +54,24 @@ fn disc_scene(x: &[f64]) -> Option<Scene> {
     Some(scene)
 }
 
+/// The search's mesh rule and, per Table 2 row, a factor that maps its frequencies to
+/// the default rule's (1 without `SQUEAL_FIT_CORRECT`).
+struct Search {
+    rule: MeshRule,
+    correction: Vec<f64>,
+}
+
+/// Table 2 rows of the disc `x` on the search's mesh, corrected, `None` when infeasible.
+fn table(x: &[f64], search: &Search) -> Option<(Vec<TableRow>, usize)> {
+    let (mut rows, dofs) = table_on(x, &search.rule)?;
+    for (r, c) in rows.iter_mut().zip(&search.correction) {
+        r.squeal_hz = r.squeal_hz.map(|f| f * c);
+    }
+    Some((rows, dofs))
+}
+
 /// Table 2 rows of the disc `x` on the mesh rule `rule`, `None` when infeasible.
-fn table(x: &[f64], rule: &MeshRule) -> Option<(Vec<TableRow>, usize)> {
+fn table_on(x: &[f64], rule: &MeshRule) -> Option<(Vec<TableRow>, usize)> {
     let mut scene = disc_scene(x)?;
     scene.mesh = rule.clone();
     let reg = squeal::registry();
@@ -106,8 +124,8 @@ fn report(x: &[f64], rows: &[TableRow], dofs: usize, c: f64, verbose: bool) {
     println!("x = {x:.4?} -> cost {c:.5}, {within5}/16 within 5 % ({dofs} DOFs)");
 }
 
-fn cost(x: &[f64], rule: &MeshRule, verbose: bool) -> f64 {
-    let Some((rows, dofs)) = table(x, rule) else {
+fn cost(x: &[f64], search: &Search, verbose: bool) -> f64 {
+    let Some((rows, dofs)) = table(x, search) else {
         return 1e3;
     };
     // log least squares, or (SQUEAL_FIT_COST=hinge) the acceptance's shape
@@ -127,7 +145,8 @@ fn main() {
         .filter_map(|a| a.parse().ok())
         .collect();
     // the search's mesh rule: the default scene's, knobs overridable
-    let mut rule = Scene::builtin("pin-on-disc").unwrap().mesh;
+    let default_rule = Scene::builtin("pin-on-disc").unwrap().mesh;
+    let mut rule = default_rule.clone();
     let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
     if let Some(v) = env("SQUEAL_FIT_EPW") {
         rule.elements_per_wavelength = v;
@@ -146,10 +165,45 @@ fn main() {
             0.0679, 0.1446, 0.0142, 0.0174, 0.0036, 0.0679, 0.0629, 0.0106,
         ],
     };
+    // with SQUEAL_FIT_CORRECT=1 the search runs on its (coarser) rule with each label's
+    // frequency scaled by default-rule / search-rule at the starting point
+    let correction = if std::env::var("SQUEAL_FIT_CORRECT").is_ok() {
+        let fine = table_on(&x0, &default_rule).expect("the starting point must be feasible");
+        let coarse = table_on(&x0, &rule).expect("the starting point must be feasible");
+        let c: Vec<f64> = fine
+            .0
+            .iter()
+            .zip(&coarse.0)
+            .map(|(f, c)| match (f.squeal_hz, c.squeal_hz) {
+                (Some(f), Some(c)) => f / c,
+                _ => 1.0,
+            })
+            .collect();
+        // a label the two meshes name differently (a ratio far from the others) or miss
+        // takes the median ratio
+        let mut sorted = c.clone();
+        sorted.sort_by(f64::total_cmp);
+        let median = sorted[sorted.len() / 2];
+        let c: Vec<f64> = c
+            .into_iter()
+            .map(|r| {
+                if (r / median - 1.0).abs() > 0.02 || r == 1.0 {
+                    median
+                } else {
+                    r
+                }
+            })
+            .collect();
+        println!("correction default / search rule per label: {c:.4?}");
+        c
+    } else {
+        vec![1.0; 16]
+    };
+    let search = Search { rule, correction };
     let n = x0.len();
-    let f = |x: &[f64]| cost(x, &rule, false);
+    let f = |x: &[f64]| cost(x, &search, false);
     if std::env::var("SQUEAL_FIT_EVAL").is_ok() {
-        cost(&x0, &rule, true);
+        cost(&x0, &search, true);
         return;
     }
     let mut simplex: Vec<(Vec<f64>, f64)> = (0..=n)
@@ -198,5 +252,5 @@ fn main() {
     }
     simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
     println!("best:");
-    cost(&simplex[0].0, &rule, true);
+    cost(&simplex[0].0, &search, true);
 }

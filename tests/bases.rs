@@ -481,12 +481,18 @@ fn modes_cut_at_the_band_top_is_flagged_by_its_backward_error() {
     );
 }
 
-/// Mu and band of the doublet probe: at mu = 0.9 (3 active pairs) the disc doublet at
-/// 3422.2 / 3422.9 Hz is coupled by friction into a flutter pair (DvR +-3e-5, measured).
+/// Mu and band of the doublet probe. On the coarse rig as built before the plate fix of
+/// session 6 (the thick plate snapped to grid lines, shorter than specified), at mu = 0.9
+/// the disc doublet at 3422.2 / 3422.9 Hz was coupled by friction into a flutter pair
+/// (DvR +-3e-5) and a basis missing one member raised the backward error 10x or more.
 const DOUBLET_MU: f64 = 0.9;
 const DOUBLET_FMAX: f64 = 4000.0;
 
 #[test]
+#[ignore = "no fixture: on the corrected coarse rig the friction-coupled doublets (3968 Hz \
+            at mu 0.5-0.8, 3537 Hz at mu 1.1-1.5) are so weakly coupled that a basis missing \
+            one member is as accurate as the intact one (forward error 1-2x), so there is \
+            nothing for the backward error to flag; needs a purpose-made strongly coupled case"]
 fn a_basis_missing_one_member_of_a_doublet_is_flagged_by_its_backward_error() {
     let reg = squeal::registry();
     let prep = Prepared::new(&reg, coarse(), "coarse").unwrap();

@@ -69,3 +69,40 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     }
     std::fs::rename(&tmp, path)
 }
+
+/// Where two JSON values first differ: a dotted path and both values (shortened).
+pub fn first_difference(a: &serde_json::Value, b: &serde_json::Value) -> String {
+    fn short(v: &serde_json::Value) -> String {
+        let t = v.to_string();
+        match t.char_indices().nth(60) {
+            Some((i, _)) => format!("{}...", &t[..i]),
+            None => t,
+        }
+    }
+    fn go(a: &serde_json::Value, b: &serde_json::Value, path: &str) -> String {
+        let join = |k: &str| {
+            if path.is_empty() {
+                k.to_string()
+            } else {
+                format!("{path}.{k}")
+            }
+        };
+        match (a, b) {
+            (serde_json::Value::Object(x), serde_json::Value::Object(y)) => x
+                .iter()
+                .find(|(k, v)| y.get(*k) != Some(*v))
+                .map(|(k, v)| match y.get(k) {
+                    Some(w) => go(v, w, &join(k)),
+                    None => format!("{} (only in one)", join(k)),
+                })
+                .or_else(|| {
+                    y.keys()
+                        .find(|k| !x.contains_key(*k))
+                        .map(|k| format!("{} (only in one)", join(k)))
+                })
+                .unwrap_or_default(),
+            _ => format!("{path}: {} vs {}", short(a), short(b)),
+        }
+    }
+    go(a, b, "")
+}

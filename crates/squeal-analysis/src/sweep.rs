@@ -268,6 +268,41 @@ impl Checkpoint {
         crate::jsonl::load(&self.path)
     }
 
+    /// Records the inputs the points depend on (scene, methods, band) next to the
+    /// checkpoint, in `<name>.inputs.json`, or checks an existing record: resuming a
+    /// checkpoint written with other inputs is an error naming the first difference, as
+    /// is a checkpoint with points but no record.
+    pub fn claim(&self, inputs: &serde_json::Value) -> Result<(), String> {
+        let record = self.path.with_extension("inputs.json");
+        let has_points = std::fs::metadata(&self.path).is_ok_and(|m| m.len() > 0);
+        match std::fs::read_to_string(&record) {
+            Ok(text) => {
+                let have: serde_json::Value = serde_json::from_str(&text)
+                    .map_err(|e| format!("{}: not valid JSON ({e})", record.display()))?;
+                if &have != inputs {
+                    return Err(format!(
+                        "{} holds a sweep of other inputs (differs at {}): use another --out, \
+                         or delete the directory to start over",
+                        self.path.display(),
+                        crate::jsonl::first_difference(&have, inputs)
+                    ));
+                }
+                Ok(())
+            }
+            Err(_) if has_points => Err(format!(
+                "{} holds points but no record of their inputs ({}): use another --out, or \
+                 delete it to start over",
+                self.path.display(),
+                record.display()
+            )),
+            Err(_) => {
+                let text = serde_json::to_string_pretty(inputs).map_err(|e| e.to_string())?;
+                crate::jsonl::write_atomic(&record, text.as_bytes())
+                    .map_err(|e| format!("{}: {e}", record.display()))
+            }
+        }
+    }
+
     /// Appends one point (flushed before returning).
     pub fn append(&self, point: &SweepPoint) -> std::io::Result<()> {
         crate::jsonl::append(&self.path, point)
@@ -383,5 +418,26 @@ mod tests {
         approx::assert_relative_eq!(signature_mac(&a, &b), 1.0, max_relative = 1e-15);
         let c = [[1.0, 0.0], [0.0, -1.0]];
         assert!(signature_mac(&a, &c) < 1e-15);
+    }
+
+    #[test]
+    fn a_checkpoint_refuses_points_of_other_inputs() {
+        let dir = std::env::temp_dir().join(format!("squeal-claim-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let ck = Checkpoint::new(dir.join("sweep.partial.jsonl"));
+        let a = serde_json::json!({"scene": "a", "basis": "enriched", "band_hz": [0.0, 1e4]});
+        let b = serde_json::json!({"scene": "a", "basis": "residue", "band_hz": [0.0, 1e4]});
+        ck.claim(&a).unwrap();
+        ck.append(&point(0.1, vec![mode(1000.0, 0.0, &[1.0])]))
+            .unwrap();
+        // the same inputs resume; other ones are refused, naming the difference
+        ck.claim(&a).unwrap();
+        let err = ck.claim(&b).unwrap_err();
+        assert!(err.contains("basis") && err.contains("residue"), "{err}");
+        // points without a record of their inputs are refused too
+        std::fs::remove_file(dir.join("sweep.partial.inputs.json")).unwrap();
+        let err = ck.claim(&a).unwrap_err();
+        assert!(err.contains("no record"), "{err}");
+        std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -84,6 +84,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<Summary> {
     let mus = mus(a.from, a.to, a.step)?;
     let (scene, file) = crate::load_scene(a.scene)?;
     std::fs::create_dir_all(a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let scene_toml = scene.to_toml();
     let prep = Prepared::new(registry, scene, &file)?;
     let free = prep
         .free_interface_modes(registry, "arpack", 1.5 * a.band[1])
@@ -104,6 +105,18 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<Summary> {
     )?;
     let step = |op: &FrictionalOperator, mu: f64, rebuilt: bool| method.solve(op, mu, rebuilt);
     let ckpt = Checkpoint::new(a.out.join("sweep.partial.jsonl"));
+    // the points depend on these (not on the mu list: shards and extensions share them)
+    let inputs = serde_json::json!({
+        "scene": scene_toml,
+        "basis": a.basis,
+        "basis_opts": a.basis_opts,
+        "eigen": a.eigen,
+        "equilibrium": a.equilibrium,
+        "law": a.law,
+        "band_hz": a.band,
+        "squeal": env!("CARGO_PKG_VERSION"),
+    });
+    ckpt.claim(&inputs).map_err(anyhow::Error::msg)?;
     let points = run_mu_sweep(
         &prep,
         registry,

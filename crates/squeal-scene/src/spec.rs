@@ -305,7 +305,7 @@ impl Default for MeshRule {
         Self {
             max_freq_hz: 10_500.0,
             elements_per_wavelength: 15.0,
-            min_layers: 3,
+            min_layers: 4,
             pin_face_elements: 20,
             grading_ratio: 1.25,
         }

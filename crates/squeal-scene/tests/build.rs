@@ -23,6 +23,9 @@ fn default_disc_mass_and_clamp() {
         let r0 = hat.radius_m.unwrap_or(d.inner_radius_m);
         let r1 = r0 + hat.thickness_m;
         volume += polygon * (r1.powi(2) - r0.powi(2)) * hat.height_m;
+        if let Some(f) = &hat.flange {
+            volume += polygon * (r1.powi(2) - f.inner_radius_m.powi(2)) * f.thickness_m;
+        }
     }
     let rel = model.total_mass / (7850.0 * volume) - 1.0;
     assert!((-3e-3..=0.0).contains(&rel), "mass error {rel:e}");
@@ -405,6 +408,7 @@ fn tributary_areas_cover_the_pin_face() {
 #[test]
 fn hat_flange_is_glued_under_the_wall_and_clamped_at_its_bore() {
     let mut scene = Scene::builtin("pin-on-disc").unwrap();
+    scene.disc.as_mut().unwrap().hat.as_mut().unwrap().flange = None;
     let plain = build(&scene, BodyKind::Disc, &registry(), "hat").unwrap();
     let d = scene.disc.as_mut().unwrap();
     let hat = d.hat.as_mut().unwrap();

@@ -226,43 +226,6 @@ pub struct RunReport {
     pub timings: TimingSummary,
 }
 
-/// Where two JSON values first differ: a dotted path and both values (shortened).
-fn first_difference(a: &serde_json::Value, b: &serde_json::Value) -> String {
-    fn short(v: &serde_json::Value) -> String {
-        let t = v.to_string();
-        match t.char_indices().nth(60) {
-            Some((i, _)) => format!("{}...", &t[..i]),
-            None => t,
-        }
-    }
-    fn go(a: &serde_json::Value, b: &serde_json::Value, path: &str) -> String {
-        let join = |k: &str| {
-            if path.is_empty() {
-                k.to_string()
-            } else {
-                format!("{path}.{k}")
-            }
-        };
-        match (a, b) {
-            (serde_json::Value::Object(x), serde_json::Value::Object(y)) => x
-                .iter()
-                .find(|(k, v)| y.get(*k) != Some(*v))
-                .map(|(k, v)| match y.get(k) {
-                    Some(w) => go(v, w, &join(k)),
-                    None => format!("{} (only in one)", join(k)),
-                })
-                .or_else(|| {
-                    y.keys()
-                        .find(|k| !x.contains_key(*k))
-                        .map(|k| format!("{} (only in one)", join(k)))
-                })
-                .unwrap_or_default(),
-            _ => format!("{path}: {} vs {}", short(a), short(b)),
-        }
-    }
-    go(a, b, "")
-}
-
 /// Writes `study.json`, or checks an existing one is the same study.
 fn claim(dir: &StudyDir, def: &StudyDef, resume: bool) -> Result<()> {
     std::fs::create_dir_all(&dir.dir).map_err(|e| files(&dir.dir, e))?;
@@ -284,7 +247,7 @@ fn claim(dir: &StudyDir, def: &StudyDef, resume: bool) -> Result<()> {
                 &dir.study(),
                 format!(
                     "written for another study (differs at {}): use another --out",
-                    first_difference(&have, &want)
+                    crate::jsonl::first_difference(&have, &want)
                 ),
             ));
         }
@@ -459,7 +422,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<(StudyDef, Summary, Timin
                 format!(
                     "another study than {} (differs at {})",
                     StudyDir::new(first).study().display(),
-                    first_difference(&want, &other)
+                    crate::jsonl::first_difference(&want, &other)
                 ),
             ));
         }
