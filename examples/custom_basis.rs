@@ -98,7 +98,7 @@ fn main() -> std::result::Result<(), Box<dyn std::error::Error>> {
     opts.band_hz = [0.0, 3000.0];
     opts.bases.retain(|b| b != "none");
     opts.eigens = vec!["dense".into()];
-    let (reference, runs) = bench_case(&reg, "example", &op, mu, &opts, None, |_| {})?;
+    let (reference, runs) = bench_case(&reg, "example", &op, None, mu, &opts, None, |_| {})?;
     println!(
         "coarse pin-on-disc, mu = {mu}: n_c = {}, reference `{}`: {} modes in 0-{} Hz, {} \
          unstable ({:.2} s)",

@@ -24,5 +24,6 @@ pub fn registry() -> Registry {
     squeal_basis_modes::register(&mut reg);
     squeal_basis_enriched::register(&mut reg);
     squeal_basis_residue::register(&mut reg);
+    squeal_basis_cms::register(&mut reg);
     reg
 }

@@ -72,6 +72,7 @@ fn build_basis(
             modal: arpack.as_ref(),
             reduced: dense.as_ref(),
             params: &ep,
+            free: None,
         })
         .unwrap()
 }

@@ -358,13 +358,52 @@ fn variants(registry: &Registry, basis: &str, opts: &BenchOptions) -> Vec<(Strin
     out
 }
 
+/// The free-interface synthesis of `model` for the candidate pairs `set`, built when a
+/// basis of `opts` asks for one (`cms`, with its default parameters: the highest cutoff
+/// asked), `None` otherwise. Built once and handed to every [`bench_case`] of the model.
+pub fn free_interface_for(
+    registry: &Registry,
+    opts: &BenchOptions,
+    model: &squeal_scene::Model,
+    set: &squeal_contact::ContactSet,
+) -> Result<Option<squeal_core::FreeInterface>> {
+    let mut cutoff: Option<f64> = None;
+    for b in opts.bases.iter().filter(|b| *b != "none") {
+        let plugin = registry
+            .bases
+            .create(b, &Params::new())
+            .map_err(core(format!("basis `{b}`")))?;
+        if let Some(c) = plugin.free_interface_cutoff(opts.band_hz[1]) {
+            cutoff = Some(cutoff.map_or(c, |x: f64| x.max(c)));
+        }
+    }
+    let Some(cutoff) = cutoff else {
+        return Ok(None);
+    };
+    let modal = registry
+        .eigen
+        .create(&opts.modal, &Params::new())
+        .map_err(core(format!("eigen solver `{}`", opts.modal)))?;
+    Ok(Some(crate::pipeline::free_interface(
+        model,
+        set,
+        modal.as_ref(),
+        &opts.params(opts.tol),
+        cutoff,
+    )?))
+}
+
 /// Runs the reference and every combination of `opts` on `op` at `mu`. `on_run` sees
 /// each run as soon as it finishes (to append it to a results file). A failing run is
-/// recorded with its error; only a failing reference stops the case.
+/// recorded with its error; only a failing reference stops the case. `free` is the
+/// free-interface synthesis of the model for the bases that ask for one (`cms`); without
+/// it (an operator read from files) such a basis is recorded as failed.
+#[allow(clippy::too_many_arguments)]
 pub fn bench_case(
     registry: &Registry,
     case: &str,
     op: &FrictionalOperator,
+    free: Option<&squeal_core::FreeInterface>,
     mu: f64,
     opts: &BenchOptions,
     memory: Option<&dyn MemoryProbe>,
@@ -492,6 +531,7 @@ pub fn bench_case(
                     modal: modal.as_ref(),
                     reduced: dense.as_ref(),
                     params: &params,
+                    free,
                 };
                 let b = plugin
                     .build(&req)

@@ -8,8 +8,12 @@ use squeal_contact::{
 };
 use squeal_core::contact::Condensation;
 use squeal_core::qep::ComplexModes;
-use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Params, Registry};
+use squeal_core::{
+    EigenParams, EigenSolver, FreeInterface, FrictionalOperator, PairDofs, Params, Registry,
+    SymmetricProblem,
+};
 use squeal_scene::{build, BodyKind, Damping, Model, Scene, SceneError};
+use std::sync::Arc;
 use std::time::Instant;
 use thiserror::Error;
 
@@ -136,6 +140,41 @@ pub fn damped_operator(
         set,
         active,
     )?)
+}
+
+/// The free-interface synthesis of `model` for the candidate pairs of `set`
+/// ([`squeal_core::synthesis`]): the normal modes of the unconstrained model up to
+/// `cutoff_hz` by `modal` (tolerances from `params`) and the static contact responses.
+pub fn free_interface(
+    model: &Model,
+    set: &ContactSet,
+    modal: &dyn EigenSolver,
+    params: &EigenParams,
+    cutoff_hz: f64,
+) -> Result<FreeInterface> {
+    let modes = modal
+        .solve_symmetric(
+            &SymmetricProblem {
+                k: model.k.as_ref(),
+                m: model.m.as_ref(),
+            },
+            &EigenParams {
+                fmin_hz: 0.0,
+                fmax_hz: cutoff_hz,
+                nev_hint: None,
+                ..params.clone()
+            },
+        )
+        .map_err(core("free-interface modes of the synthesis"))?;
+    let pairs: Vec<PairDofs> = (0..set.len())
+        .map(|i| PairDofs {
+            pin: set.pin_dofs[i],
+            disc: set.disc_dofs[i],
+            direction: set.direction[i],
+        })
+        .collect();
+    FreeInterface::new(model.k.as_ref(), model.m.as_ref(), &pairs, &modes)
+        .map_err(core("free-interface synthesis"))
 }
 
 /// Complex modes of `op` at `mu` with the named eigen solver, timed.
@@ -333,6 +372,7 @@ pub struct Method {
     modal: Box<dyn EigenSolver>,
     params: EigenParams,
     cached: Option<squeal_core::reduction::ReducedOperator>,
+    free: Option<Arc<FreeInterface>>,
     last: StepTimes,
 }
 
@@ -384,8 +424,40 @@ impl Method {
                 .map_err(core("modal eigen solver"))?,
             params,
             cached: None,
+            free: None,
             last: StepTimes::default(),
         })
+    }
+
+    /// The free-interface cutoff (Hz) the basis asks for, `None` when it needs no
+    /// free-interface synthesis (full order, or any basis but `cms`).
+    pub fn free_interface_cutoff(&self) -> Option<f64> {
+        self.basis
+            .as_ref()
+            .and_then(|b| b.free_interface_cutoff(self.params.fmax_hz))
+    }
+
+    /// Builds the free-interface synthesis the basis needs (once: a later call keeps the
+    /// one it has) for `model` and the candidate pairs `set`, every contact set solved
+    /// later being a subset of them. Returns it, shared (`None` when the basis needs none).
+    pub fn prepare_free_interface(
+        &mut self,
+        model: &Model,
+        set: &ContactSet,
+    ) -> Result<Option<Arc<FreeInterface>>> {
+        let Some(cutoff) = self.free_interface_cutoff() else {
+            return Ok(None);
+        };
+        if self.free.is_none() {
+            let fi = free_interface(model, set, self.modal.as_ref(), &self.params, cutoff)?;
+            self.free = Some(Arc::new(fi));
+        }
+        Ok(self.free.clone())
+    }
+
+    /// Hands a free-interface synthesis built elsewhere (shared by parallel workers).
+    pub fn set_free_interface(&mut self, free: Option<Arc<FreeInterface>>) {
+        self.free = free;
     }
 
     /// Where the time of the last [`solve`](Self::solve) went.
@@ -422,6 +494,7 @@ impl Method {
                 modal: self.modal.as_ref(),
                 reduced: self.eigen.as_ref(),
                 params: &self.params,
+                free: self.free.as_deref(),
             };
             let b = basis
                 .build(&req)

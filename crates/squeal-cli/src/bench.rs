@@ -293,6 +293,19 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
             .map(|&mu| (format!("mu={mu}"), format!("mu = {mu}"), mu, None, None))
             .collect()
     };
+    // the free-interface synthesis of the scene's model, for a basis that asks for one
+    // (every pair of the face: a stress zone is a subset)
+    let free = match &src.prep {
+        Some(prep) => {
+            let all = squeal_contact::ContactSet::new(
+                &prep.model,
+                &Zone::Uniform,
+                prep.scene.study.rotation,
+            )?;
+            squeal_analysis::bench::free_interface_for(registry, &a.opts, &prep.model, &all)?
+        }
+        None => None,
+    };
     let mut all_runs = Vec::new();
     let mut refs = Vec::new();
     let mut infos = Vec::new();
@@ -313,12 +326,13 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
             opts.defaults = false;
         }
         let mut append_err = None;
-        let (reference, runs) = bench_case(registry, case, &op, *mu, &opts, probe, |r| {
-            print_run(r);
-            if let Err(e) = append(&partial, r) {
-                append_err.get_or_insert(e);
-            }
-        })?;
+        let (reference, runs) =
+            bench_case(registry, case, &op, free.as_ref(), *mu, &opts, probe, |r| {
+                print_run(r);
+                if let Err(e) = append(&partial, r) {
+                    append_err.get_or_insert(e);
+                }
+            })?;
         if let Some(e) = append_err {
             return Err(e);
         }

@@ -76,6 +76,8 @@ pub struct Source {
     pub damping: String,
     pub equilibrium_time_s: f64,
     pub operator_time_s: f64,
+    /// The built scene (none for an operator read from files).
+    pub prep: Option<Prepared>,
 }
 
 pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
@@ -101,6 +103,7 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
             damping,
             equilibrium_time_s: 0.0,
             operator_time_s: start.elapsed().as_secs_f64(),
+            prep: None,
         });
     }
     let (scene, file) = crate::load_scene(a.scene)?;
@@ -120,6 +123,7 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
         damping: prep.scene.damping.describe(),
         equilibrium_time_s,
         operator_time_s: t1.elapsed().as_secs_f64(),
+        prep: Some(prep),
     })
 }
 
@@ -140,6 +144,9 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
         "arpack",
         params,
     )?;
+    if let Some(prep) = &src.prep {
+        method.prepare_free_interface(&prep.model, &prep.set)?;
+    }
     let (modes, basis_size, basis_time_s) = method.solve(&src.op, src.mu, true)?;
     let out: Vec<ModeOut> = (0..modes.len())
         .map(|i| ModeOut {

@@ -103,6 +103,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<Summary> {
         "arpack",
         params,
     )?;
+    method.prepare_free_interface(&prep.model, &prep.set)?;
     let step = |op: &FrictionalOperator, mu: f64, rebuilt: bool| method.solve(op, mu, rebuilt);
     let ckpt = Checkpoint::new(a.out.join("sweep.partial.jsonl"));
     // the points depend on these (not on the mu list: shards and extensions share them)

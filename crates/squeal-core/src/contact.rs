@@ -231,6 +231,9 @@ pub struct BasisRequest<'a> {
     pub reduced: &'a dyn EigenSolver,
     /// Tolerances and limits handed to both solvers (their band fields are overridden).
     pub params: &'a EigenParams,
+    /// The free-interface synthesis of the model, built once by the caller for a basis
+    /// that asks for it ([`ReductionBasis::free_interface_cutoff`]); `None` otherwise.
+    pub free: Option<&'a crate::synthesis::FreeInterface>,
 }
 
 /// Builds a reduction basis for one frictional operator.
@@ -245,6 +248,15 @@ pub trait ReductionBasis: Send + Sync {
     /// contact set and reused across a whole mu sweep.
     fn depends_on_mu(&self) -> bool {
         false
+    }
+    /// The highest free-interface frequency (Hz) the basis needs when it works from a
+    /// [`FreeInterface`](crate::synthesis::FreeInterface) of the model, for a band whose
+    /// top is `band_top_hz`; `None` (the default) when it does not. The caller then builds
+    /// that synthesis once per model and candidate pairs and hands it to every
+    /// [`build`](Self::build) in [`BasisRequest::free`].
+    fn free_interface_cutoff(&self, band_top_hz: f64) -> Option<f64> {
+        let _ = band_top_hz;
+        None
     }
     /// Builds the basis described by `request`.
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis>;

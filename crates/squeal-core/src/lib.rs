@@ -10,7 +10,8 @@
 //! - the [`Registry`] that maps plugin names to constructors;
 //! - shared numerical machinery that every backend uses the same way ([`linalg`], [`qep`],
 //!   [`lowrank`] for the Woodbury path of undamped frictional operators, and [`reduction`]
-//!   for the reduction bases).
+//!   for the reduction bases, [`synthesis`] for the free-interface modal synthesis shared by
+//!   every contact set of a study).
 //!
 //! Units: SI throughout (m, kg, s, N, Pa); frequencies in Hz, eigenvalues of the
 //! symmetric problem `K x = omega^2 M x` in (rad/s)^2.
@@ -26,6 +27,7 @@ pub mod params;
 pub mod qep;
 pub mod reduction;
 pub mod registry;
+pub mod synthesis;
 
 pub use contact::{
     Basis, BasisRequest, ContactLaw, EquilibriumSolver, FrictionalOperator, ReductionBasis,
@@ -44,6 +46,7 @@ pub use qep::{
 };
 pub use reduction::{solve_reduced, ReducedOperator, ReducedSolve};
 pub use registry::Registry;
+pub use synthesis::{FreeInterface, PairDofs, Synthesized};
 
 pub use faer;
 /// Complex double, the scalar of the frictional (non-symmetric) problems.

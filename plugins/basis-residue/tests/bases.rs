@@ -143,6 +143,7 @@ fn run_basis(
             modal,
             reduced: dense.as_ref(),
             params: &ep,
+            free: None,
         })
         .unwrap();
     assert!(
@@ -315,6 +316,7 @@ fn residue_depends_on_mu_and_refuses_another_mu() {
         modal: arpack.as_ref(),
         reduced: dense.as_ref(),
         params: &ep,
+        free: None,
     };
     // a residue basis with one iteration allowed and a tight tolerance reports that it
     // stopped on the cap

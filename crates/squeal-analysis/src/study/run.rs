@@ -305,7 +305,7 @@ pub fn run(
     }
     let list = def.cases()?;
     // fail fast on unknown plugins or parameters
-    drop(def.solve.method(registry)?);
+    let mut probe = def.solve.method(registry)?;
     claim(dir, def, opts.resume)?;
     let done: std::collections::BTreeSet<String> =
         dir.records()?.into_iter().map(|r| r.case.id).collect();
@@ -325,6 +325,16 @@ pub fn run(
     let limit = opts.max_cases.unwrap_or(usize::MAX);
     let remaining = todo.len().saturating_sub(limit);
     todo.truncate(limit);
+    // a basis working from the free-interface synthesis (`cms`) gets one, built here once
+    // for every pair of the face and shared by the workers
+    let free = if todo.is_empty() || probe.free_interface_cutoff().is_none() {
+        None
+    } else {
+        let all = ContactSet::new(model, &squeal_scene::Zone::Uniform, def.rotation)
+            .map_err(PipelineError::from)?;
+        probe.prepare_free_interface(model, &all)?
+    };
+    drop(probe);
     progress(Progress::Start {
         resumed,
         todo: todo.len(),
@@ -358,6 +368,7 @@ pub fn run(
     let next = std::sync::atomic::AtomicUsize::new(0);
     let worker = || match def.solve.method(registry) {
         Ok(mut method) => loop {
+            method.set_free_interface(free.clone());
             if failed() {
                 break;
             }

@@ -1,0 +1,524 @@
+//! Free-interface modal synthesis with residual flexibility (MacNeal) for a family of
+//! contact sets drawn from one set of candidate pairs: the machinery behind the `cms`
+//! basis, built once per model and region and then reused for every contact set and mu.
+//!
+//! For the active pairs `A` the linearized problem is the descriptor system
+//! `(lambda^2 M + K) u = B_A^T r`, `Pn_A u = 0`, `B_A = Pn_A + mu Pt_A` (METHODS.md
+//! section 2, undamped). With the free-interface modes `Phi` of the unconstrained model
+//! (no pair tied: `K Phi = M Phi Omega^2`, `Phi^T M Phi = I`) up to a cutoff, and the
+//! residual flexibility `G = K^-1 - Phi Omega^-2 Phi^T` taken at `lambda = 0`,
+//!
+//! `u = Phi eta + G B_A^T r`, `(lambda^2 + Omega^2) eta = Phi^T B_A^T r`.
+//!
+//! The ties give `r = -S^-1 P eta` with `S = Pn_A G B_A^T` (`nA x nA`) and `P = Pn_A Phi`,
+//! hence the `m x m` standard eigenproblem `lambda^2 eta = -(Omega^2 + Q^T S^-1 P) eta`,
+//! `Q = B_A Phi`, whatever the number of pairs. The columns `K^-1 Pn^T`, `K^-1 Pt^T` of
+//! every candidate pair and the residual contact flexibilities `Pn G Pn^T`, `Pn G Pt^T`
+//! are computed once (one Cholesky factorization of `K`, `2 nR` solves): a new contact set
+//! or mu then costs one `nA x nA` LU, one `m x m` eigen decomposition and the expansion
+//! `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r`, which satisfies `Pn_A u = 0` exactly.
+//!
+//! The residual flexibility is static (its inertia is neglected), so the synthesized modes
+//! are approximations whose error falls with the ratio of the band to the modal cutoff;
+//! the `cms` basis uses them as Ritz vectors of the exact operator of the contact set, so
+//! every returned mode still carries its backward error on the full operator.
+//!
+//! Normals are `+e_z` (flat disc face), as in the operator builder.
+
+use crate::contact::FrictionalOperator;
+use crate::eigen::RealModes;
+use crate::linalg::Cholesky;
+use crate::{c64, Error, Result, SparseRef};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatRef, Par};
+use std::time::Instant;
+
+/// The DOFs of one candidate contact pair in the unconstrained (free) numbering.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairDofs {
+    /// Pin node DOFs (x, y, z).
+    pub pin: [usize; 3],
+    /// Disc node DOFs (x, y, z).
+    pub disc: [usize; 3],
+    /// Unit in-plane sliding direction `e_i` (the friction on the pin points along it).
+    pub direction: [f64; 3],
+}
+
+/// The free-interface data of one model and one set of candidate pairs (see the module
+/// docs): modes, static contact responses and residual contact flexibilities.
+pub struct FreeInterface {
+    pairs: Vec<PairDofs>,
+    phi: Mat<f64>,
+    omega2: Vec<f64>,
+    /// `K^-1 Pn^T` (`n x nR`, m/N).
+    zn: Mat<f64>,
+    /// `K^-1 Pt^T` (`n x nR`, m/N).
+    zt: Mat<f64>,
+    /// `K^-1 M K^-1 Pn^T`, `K^-1 M K^-1 Pt^T` (`n x nR`): the second-order residual terms.
+    yn: Mat<f64>,
+    yt: Mat<f64>,
+    /// Full static `Pn K^-1 Pn^T` (`nR x nR`, m/N).
+    wfull: Mat<f64>,
+    /// Residual `Pn G Pn^T` (`nR x nR`, m/N).
+    wn: Mat<f64>,
+    /// Residual `Pn G Pt^T` (`nR x nR`, m/N).
+    wt: Mat<f64>,
+    /// `Pn Phi`, `Pt Phi` (`nR x m`).
+    pn_phi: Mat<f64>,
+    pt_phi: Mat<f64>,
+    /// Highest free-interface frequency kept (Hz).
+    pub cutoff_hz: f64,
+    /// Wall time of the construction, modes excluded (s).
+    pub time_s: f64,
+}
+
+/// The synthesized modes of one contact set at one mu.
+#[derive(Debug, Clone)]
+pub struct Synthesized {
+    /// Eigenvalues `s = -lambda^2` ((rad/s)^2), one per free-interface mode.
+    pub s: Vec<c64>,
+    /// Modal coordinates `eta` (`m x m`, one column per `s`).
+    pub eta: Mat<c64>,
+    /// Normal reactions `r = -S^-1 P eta` of the active pairs (`nA x m`, N).
+    pub r: Mat<c64>,
+    /// Region indices of the active pairs (rows of `r`).
+    pub active: Vec<usize>,
+    /// Friction coefficient.
+    pub mu: f64,
+}
+
+impl Synthesized {
+    /// `lambda = i sqrt(s)` on the branch with `Im(lambda) >= 0`; its frequency (Hz) is
+    /// `Im(lambda) / 2 pi`.
+    pub fn lambda(&self, k: usize) -> c64 {
+        let root = self.s[k].sqrt();
+        c64::new(-root.im, root.re)
+    }
+
+    /// Frequency of synthesized mode `k` (Hz).
+    pub fn freq_hz(&self, k: usize) -> f64 {
+        self.lambda(k).im / (2.0 * std::f64::consts::PI)
+    }
+}
+
+fn par() -> Par {
+    faer::get_global_parallelism()
+}
+
+impl FreeInterface {
+    /// Builds the free-interface data of the model `(k, m)` (free DOFs, `K` positive
+    /// definite) for the candidate `pairs`, with the free-interface `modes` (of the same
+    /// `(K, M)`, `M`-orthonormal, e.g. from an [`EigenSolver`](crate::EigenSolver) up to a
+    /// cutoff above the band).
+    pub fn new(
+        k: SparseRef<'_>,
+        m: SparseRef<'_>,
+        pairs: &[PairDofs],
+        modes: &RealModes,
+    ) -> Result<Self> {
+        let start = Instant::now();
+        let n = k.nrows();
+        let nr = pairs.len();
+        let nm = modes.omega2.len();
+        if nr == 0 {
+            return Err(Error::Invalid(
+                "free-interface synthesis: no candidate contact pair".into(),
+            ));
+        }
+        if modes.vectors.nrows() != n || modes.vectors.ncols() != nm {
+            return Err(Error::Dimension {
+                context: "free-interface synthesis: mode shapes against K".into(),
+                expected: n,
+                got: modes.vectors.nrows(),
+            });
+        }
+        if nm == 0 {
+            return Err(Error::Invalid(
+                "free-interface synthesis: no free-interface mode below the cutoff".into(),
+            ));
+        }
+        if let Some(&w) = modes.omega2.iter().find(|w| !(w.is_finite() && **w > 0.0)) {
+            return Err(Error::Invalid(format!(
+                "free-interface synthesis: eigenvalue omega^2 = {w:e} (rad/s)^2 is not \
+                 positive: the unconstrained model must be held (no rigid-body mode)"
+            )));
+        }
+        for (i, p) in pairs.iter().enumerate() {
+            if p.pin.iter().chain(&p.disc).any(|&d| d >= n) {
+                return Err(Error::Invalid(format!(
+                    "free-interface synthesis: pair {i} has a DOF beyond the model's {n}"
+                )));
+            }
+        }
+        let factor = Cholesky::new(k, "K (free-interface synthesis)")?;
+        let mut zn = Mat::<f64>::zeros(n, nr);
+        let mut zt = Mat::<f64>::zeros(n, nr);
+        for (j, p) in pairs.iter().enumerate() {
+            zn[(p.pin[2], j)] += 1.0;
+            zn[(p.disc[2], j)] -= 1.0;
+            for a in 0..2 {
+                zt[(p.pin[a], j)] += p.direction[a];
+                zt[(p.disc[a], j)] -= p.direction[a];
+            }
+        }
+        const BLOCK: usize = 64;
+        for z in [&mut zn, &mut zt] {
+            let mut c0 = 0;
+            while c0 < nr {
+                let b = BLOCK.min(nr - c0);
+                factor.solve_in_place(z.as_mut().subcols_mut(c0, b));
+                c0 += b;
+            }
+        }
+        // second-order residual terms K^-1 M K^-1 (Pn^T | Pt^T)
+        let mut yn = crate::reduction::sparse_times(m, zn.as_ref());
+        let mut yt = crate::reduction::sparse_times(m, zt.as_ref());
+        for y in [&mut yn, &mut yt] {
+            let mut c0 = 0;
+            while c0 < nr {
+                let b = BLOCK.min(nr - c0);
+                factor.solve_in_place(y.as_mut().subcols_mut(c0, b));
+                c0 += b;
+            }
+        }
+        let pn_rows = |x: MatRef<'_, f64>| {
+            Mat::from_fn(nr, x.ncols(), |i, c| {
+                x[(pairs[i].pin[2], c)] - x[(pairs[i].disc[2], c)]
+            })
+        };
+        let pt_rows = |x: MatRef<'_, f64>| {
+            Mat::from_fn(nr, x.ncols(), |i, c| {
+                let p = &pairs[i];
+                (0..2)
+                    .map(|a| p.direction[a] * (x[(p.pin[a], c)] - x[(p.disc[a], c)]))
+                    .sum()
+            })
+        };
+        let phi = modes.vectors.clone();
+        let pn_phi = pn_rows(phi.as_ref());
+        let pt_phi = pt_rows(phi.as_ref());
+        let wfull = pn_rows(zn.as_ref());
+        let mut wn = wfull.clone();
+        let mut wt = pn_rows(zt.as_ref());
+        // residual flexibility: subtract Pn Phi Omega^-2 (Pn Phi | Pt Phi)^T
+        let scaled = Mat::from_fn(nr, nm, |i, c| pn_phi[(i, c)] / modes.omega2[c]);
+        matmul(
+            wn.as_mut(),
+            Accum::Add,
+            scaled.as_ref(),
+            pn_phi.transpose(),
+            -1.0,
+            par(),
+        );
+        matmul(
+            wt.as_mut(),
+            Accum::Add,
+            scaled.as_ref(),
+            pt_phi.transpose(),
+            -1.0,
+            par(),
+        );
+        let cutoff_hz = modes.omega2.iter().fold(0.0f64, |a, &w| a.max(w)).sqrt()
+            / (2.0 * std::f64::consts::PI);
+        Ok(Self {
+            pairs: pairs.to_vec(),
+            phi,
+            omega2: modes.omega2.clone(),
+            zn,
+            zt,
+            yn,
+            yt,
+            wfull,
+            wn,
+            wt,
+            pn_phi,
+            pt_phi,
+            cutoff_hz,
+            time_s: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Number of candidate pairs.
+    pub fn pairs(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Number of free-interface modes.
+    pub fn modes(&self) -> usize {
+        self.omega2.len()
+    }
+
+    /// Number of unconstrained DOFs.
+    pub fn dofs(&self) -> usize {
+        self.phi.nrows()
+    }
+
+    /// The candidate pairs (region indices are positions in this list).
+    pub fn pair_dofs(&self) -> &[PairDofs] {
+        &self.pairs
+    }
+
+    /// The region indices of the pairs tied in `op` (its index map relabels their pin
+    /// normal DOF onto the disc's). An error when `op` has no index map, another size, or
+    /// active pairs outside the candidate set.
+    pub fn active_in(&self, op: &FrictionalOperator) -> Result<Vec<usize>> {
+        let t = op.t.as_ref().ok_or_else(|| {
+            Error::Invalid(
+                "free-interface synthesis: the operator has no index map T (it was read \
+                 from files); build it from a scene"
+                    .into(),
+            )
+        })?;
+        if t.len() != self.dofs() {
+            return Err(Error::Dimension {
+                context: "free-interface synthesis: operator's unconstrained DOFs".into(),
+                expected: self.dofs(),
+                got: t.len(),
+            });
+        }
+        let active: Vec<usize> = (0..self.pairs.len())
+            .filter(|&i| t[self.pairs[i].pin[2]] == t[self.pairs[i].disc[2]])
+            .collect();
+        let tied = t.len() - op.dim();
+        if tied != active.len() {
+            return Err(Error::Invalid(format!(
+                "free-interface synthesis: the operator ties {tied} pairs but only {} of \
+                 them are among the {} candidate pairs of the synthesis",
+                active.len(),
+                self.pairs.len()
+            )));
+        }
+        Ok(active)
+    }
+
+    /// The synthesized modes of the contact set `active` (region indices) at `mu`.
+    pub fn synthesize(&self, active: &[usize], mu: f64) -> Result<Synthesized> {
+        if !mu.is_finite() {
+            return Err(Error::param("mu", format!("must be finite, got {mu}")));
+        }
+        if let Some(&i) = active.iter().find(|&&i| i >= self.pairs.len()) {
+            return Err(Error::Invalid(format!(
+                "free-interface synthesis: pair index {i} beyond the {} candidates",
+                self.pairs.len()
+            )));
+        }
+        let na = active.len();
+        let nm = self.modes();
+        let p = Mat::from_fn(na, nm, |i, c| self.pn_phi[(active[i], c)]);
+        let q = Mat::from_fn(na, nm, |i, c| {
+            self.pn_phi[(active[i], c)] + mu * self.pt_phi[(active[i], c)]
+        });
+        let mut a = Mat::from_fn(nm, nm, |i, j| if i == j { self.omega2[i] } else { 0.0 });
+        let mut x = Mat::<f64>::zeros(na, nm);
+        if na > 0 {
+            let s = Mat::from_fn(na, na, |i, j| {
+                self.wn[(active[i], active[j])] + mu * self.wt[(active[i], active[j])]
+            });
+            let lu = s.partial_piv_lu();
+            let u = lu.U();
+            let (mut pmin, mut pmax) = (f64::INFINITY, 0.0f64);
+            for i in 0..na {
+                pmin = pmin.min(u[(i, i)].abs());
+                pmax = pmax.max(u[(i, i)].abs());
+            }
+            if pmin.is_nan() || pmin <= 1e-13 * pmax {
+                return Err(Error::Factorization {
+                    what: format!("residual contact flexibility S ({na} pairs)"),
+                    reason: format!(
+                        "numerically singular (pivot ratio {:.2e}): a pair repeated, or \
+                         the free-interface modes span the contact motions exactly",
+                        pmin / pmax
+                    ),
+                });
+            }
+            x = faer::linalg::solvers::Solve::solve(&lu, &p);
+            matmul(
+                a.as_mut(),
+                Accum::Add,
+                q.transpose(),
+                x.as_ref(),
+                1.0,
+                par(),
+            );
+        }
+        let eig = faer::linalg::solvers::Eigen::new_from_real(a.as_ref()).map_err(|e| {
+            Error::NotConverged {
+                method: "free-interface synthesis (dense eigen)".into(),
+                iterations: 0,
+                detail: format!("{e:?}"),
+            }
+        })?;
+        let s: Vec<c64> = (0..nm).map(|k| eig.S()[k]).collect();
+        let eta = eig.U().to_owned();
+        let mut r = Mat::<c64>::zeros(na, nm);
+        for k in 0..nm {
+            for i in 0..na {
+                let mut acc = c64::new(0.0, 0.0);
+                for c in 0..nm {
+                    acc += eta[(c, k)] * x[(i, c)];
+                }
+                r[(i, k)] = -acc;
+            }
+        }
+        Ok(Synthesized {
+            s,
+            eta,
+            r,
+            active: active.to_vec(),
+            mu,
+        })
+    }
+
+    /// The unconstrained displacements `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r` of the
+    /// synthesized modes `which` (`n x which.len()`).
+    pub fn expand(&self, syn: &Synthesized, which: &[usize]) -> Mat<c64> {
+        let n = self.dofs();
+        let nm = self.modes();
+        let nr = self.pairs();
+        let k = which.len();
+        let mu = syn.mu;
+        // real and imaginary parts side by side: columns [re_0..re_k | im_0..im_k]
+        let mut coef = Mat::<f64>::zeros(nm, 2 * k);
+        let mut rfull = Mat::<f64>::zeros(nr, 2 * k);
+        for (c, &w) in which.iter().enumerate() {
+            for (row, &i) in syn.active.iter().enumerate() {
+                let rv = syn.r[(row, w)];
+                rfull[(i, c)] = rv.re;
+                rfull[(i, k + c)] = rv.im;
+            }
+            for j in 0..nm {
+                let mut qtr = c64::new(0.0, 0.0);
+                for (row, &i) in syn.active.iter().enumerate() {
+                    qtr += syn.r[(row, w)] * (self.pn_phi[(i, j)] + mu * self.pt_phi[(i, j)]);
+                }
+                let e = syn.eta[(j, w)] - qtr * (1.0 / self.omega2[j]);
+                coef[(j, c)] = e.re;
+                coef[(j, k + c)] = e.im;
+            }
+        }
+        let mut u = Mat::<f64>::zeros(n, 2 * k);
+        matmul(
+            u.as_mut(),
+            Accum::Replace,
+            self.phi.as_ref(),
+            coef.as_ref(),
+            1.0,
+            par(),
+        );
+        matmul(
+            u.as_mut(),
+            Accum::Add,
+            self.zn.as_ref(),
+            rfull.as_ref(),
+            1.0,
+            par(),
+        );
+        if mu != 0.0 {
+            matmul(
+                u.as_mut(),
+                Accum::Add,
+                self.zt.as_ref(),
+                rfull.as_ref(),
+                mu,
+                par(),
+            );
+        }
+        Mat::from_fn(n, k, |i, c| c64::new(u[(i, c)], u[(i, k + c)]))
+    }
+
+    /// The second-order residual directions of the synthesized modes `which`:
+    /// `w = G2 B_A^T r`, `G2 = K^-1 M K^-1 - Phi Omega^-4 Phi^T` (the first term the static
+    /// residual flexibility leaves out, `R(lambda) = G - lambda^2 G2 + ...`), made to satisfy
+    /// the ties by the static correction `w - K^-1 Pn_A^T (Pn_A K^-1 Pn_A^T)^-1 Pn_A w`
+    /// (`n x which.len()`). Added to the expanded modes they let the Ritz step recover most
+    /// of the residual inertia.
+    pub fn correction(&self, syn: &Synthesized, which: &[usize]) -> Result<Mat<c64>> {
+        let n = self.dofs();
+        let nm = self.modes();
+        let nr = self.pairs();
+        let na = syn.active.len();
+        let k = which.len();
+        let mu = syn.mu;
+        let mut coef = Mat::<f64>::zeros(nm, 2 * k);
+        let mut rfull = Mat::<f64>::zeros(nr, 2 * k);
+        for (c, &w) in which.iter().enumerate() {
+            for (row, &i) in syn.active.iter().enumerate() {
+                let rv = syn.r[(row, w)];
+                rfull[(i, c)] = rv.re;
+                rfull[(i, k + c)] = rv.im;
+            }
+            for j in 0..nm {
+                let mut qtr = c64::new(0.0, 0.0);
+                for (row, &i) in syn.active.iter().enumerate() {
+                    qtr += syn.r[(row, w)] * (self.pn_phi[(i, j)] + mu * self.pt_phi[(i, j)]);
+                }
+                let e = qtr * (-1.0 / (self.omega2[j] * self.omega2[j]));
+                coef[(j, c)] = e.re;
+                coef[(j, k + c)] = e.im;
+            }
+        }
+        let mut w = Mat::<f64>::zeros(n, 2 * k);
+        matmul(
+            w.as_mut(),
+            Accum::Replace,
+            self.phi.as_ref(),
+            coef.as_ref(),
+            1.0,
+            par(),
+        );
+        matmul(
+            w.as_mut(),
+            Accum::Add,
+            self.yn.as_ref(),
+            rfull.as_ref(),
+            1.0,
+            par(),
+        );
+        if mu != 0.0 {
+            matmul(
+                w.as_mut(),
+                Accum::Add,
+                self.yt.as_ref(),
+                rfull.as_ref(),
+                mu,
+                par(),
+            );
+        }
+        if na > 0 {
+            // static correction onto the ties: c = W_AA^-1 Pn_A w, w -= K^-1 Pn_A^T c
+            let waa = Mat::from_fn(na, na, |i, j| self.wfull[(syn.active[i], syn.active[j])]);
+            let gaps = Mat::from_fn(na, 2 * k, |i, c| {
+                let p = &self.pairs[syn.active[i]];
+                w[(p.pin[2], c)] - w[(p.disc[2], c)]
+            });
+            let lu = waa.partial_piv_lu();
+            let cfix = faer::linalg::solvers::Solve::solve(&lu, &gaps);
+            if !(0..2 * k).all(|c| (0..na).all(|i| cfix[(i, c)].is_finite())) {
+                return Err(Error::Factorization {
+                    what: format!("static contact flexibility ({na} pairs)"),
+                    reason: "singular: a pair repeated".into(),
+                });
+            }
+            let mut cf = Mat::<f64>::zeros(nr, 2 * k);
+            for (row, &i) in syn.active.iter().enumerate() {
+                for c in 0..2 * k {
+                    cf[(i, c)] = cfix[(row, c)];
+                }
+            }
+            matmul(
+                w.as_mut(),
+                Accum::Add,
+                self.zn.as_ref(),
+                cf.as_ref(),
+                -1.0,
+                par(),
+            );
+        }
+        Ok(Mat::from_fn(n, k, |i, c| {
+            c64::new(w[(i, c)], w[(i, k + c)])
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,218 @@
+//! Unit tests of the free-interface synthesis on a small spring-mass model whose exact
+//! constrained spectrum is known densely.
+
+use super::*;
+use crate::eigen::SolveInfo;
+use crate::SparseMat;
+use faer::sparse::Triplet;
+use faer::Side;
+
+const N: usize = 24;
+
+/// A chain of `N` masses (diagonal mass) with springs to ground and to neighbours up to
+/// three apart: symmetric positive definite, fully populated band.
+fn model() -> (Mat<f64>, Vec<f64>) {
+    let mut k = Mat::<f64>::zeros(N, N);
+    for i in 0..N {
+        k[(i, i)] += 1.0 + 0.1 * i as f64;
+        for d in 1..=3 {
+            if i + d < N {
+                let s = 2.0 / d as f64 + 0.05 * ((i * 7 + d) % 5) as f64;
+                k[(i, i)] += s;
+                k[(i + d, i + d)] += s;
+                k[(i, i + d)] -= s;
+                k[(i + d, i)] -= s;
+            }
+        }
+    }
+    let m = (0..N).map(|i| 1.0 + 0.3 * ((i * 5) % 7) as f64).collect();
+    (k, m)
+}
+
+fn sparse(k: &Mat<f64>) -> SparseMat {
+    let mut trip = Vec::new();
+    for j in 0..N {
+        for i in 0..N {
+            if k[(i, j)] != 0.0 {
+                trip.push(Triplet::new(i, j, k[(i, j)]));
+            }
+        }
+    }
+    SparseMat::try_new_from_triplets(N, N, &trip).unwrap()
+}
+
+fn mass(m: &[f64]) -> SparseMat {
+    let trip: Vec<_> = (0..N).map(|i| Triplet::new(i, i, m[i])).collect();
+    SparseMat::try_new_from_triplets(N, N, &trip).unwrap()
+}
+
+/// The first `count` modes of `(K, diag(m))`, mass-normalized.
+fn modes(k: &Mat<f64>, m: &[f64], count: usize) -> RealModes {
+    let a = Mat::from_fn(N, N, |i, j| k[(i, j)] / (m[i] * m[j]).sqrt());
+    let eig = a.self_adjoint_eigen(Side::Lower).unwrap();
+    let omega2: Vec<f64> = (0..count).map(|c| eig.S()[c]).collect();
+    let vectors = Mat::from_fn(N, count, |i, c| eig.U()[(i, c)] / m[i].sqrt());
+    RealModes {
+        freq_hz: omega2
+            .iter()
+            .map(|w| w.sqrt() / (2.0 * std::f64::consts::PI))
+            .collect(),
+        omega2,
+        vectors,
+        residuals: vec![0.0; count],
+        info: SolveInfo::new("test"),
+    }
+}
+
+/// Pairs: "pin" DOFs (x, y, z) = (3i, 3i+1, 3i+2) against "disc" DOFs 12 + 3i .. .
+fn pairs() -> Vec<PairDofs> {
+    (0..4)
+        .map(|i| PairDofs {
+            pin: [3 * i, 3 * i + 1, 3 * i + 2],
+            disc: [12 + 3 * i, 12 + 3 * i + 1, 12 + 3 * i + 2],
+            direction: [0.6, 0.8, 0.0],
+        })
+        .collect()
+}
+
+/// The exact mu = 0 spectrum (omega^2, ascending) with the pairs `active` tied: the pin
+/// normal DOF merged into the disc's (masses and stiffness summed).
+fn exact_tied(k: &Mat<f64>, m: &[f64], active: &[usize]) -> Vec<f64> {
+    let pr = pairs();
+    let mut t: Vec<usize> = (0..N).collect();
+    for &i in active {
+        t[pr[i].pin[2]] = pr[i].disc[2];
+    }
+    let keep: Vec<usize> = (0..N).filter(|&j| t[j] == j).collect();
+    let pos = |j: usize| keep.iter().position(|&x| x == t[j]).unwrap();
+    let nc = keep.len();
+    let mut kc = Mat::<f64>::zeros(nc, nc);
+    let mut mc = vec![0.0; nc];
+    for j in 0..N {
+        mc[pos(j)] += m[j];
+        for i in 0..N {
+            kc[(pos(i), pos(j))] += k[(i, j)];
+        }
+    }
+    let a = Mat::from_fn(nc, nc, |i, j| kc[(i, j)] / (mc[i] * mc[j]).sqrt());
+    let eig = a.self_adjoint_eigen(Side::Lower).unwrap();
+    (0..nc).map(|c| eig.S()[c]).collect()
+}
+
+#[test]
+fn no_pair_gives_the_free_modes() {
+    let (k, m) = model();
+    let fi = FreeInterface::new(
+        sparse(&k).as_ref(),
+        mass(&m).as_ref(),
+        &pairs(),
+        &modes(&k, &m, 10),
+    )
+    .unwrap();
+    let syn = fi.synthesize(&[], 0.4).unwrap();
+    let mut s: Vec<f64> = syn.s.iter().map(|z| z.re).collect();
+    s.sort_by(f64::total_cmp);
+    let free = modes(&k, &m, 10).omega2;
+    for (a, b) in s.iter().zip(&free) {
+        assert!((a - b).abs() <= 1e-12 * b, "{a} vs {b}");
+    }
+}
+
+#[test]
+fn mu_zero_converges_to_the_tied_spectrum() {
+    let (k, m) = model();
+    let active = [0, 2, 3];
+    let exact = exact_tied(&k, &m, &active);
+    let mut errors = Vec::new();
+    for count in [6, 12, 18] {
+        let fi = FreeInterface::new(
+            sparse(&k).as_ref(),
+            mass(&m).as_ref(),
+            &pairs(),
+            &modes(&k, &m, count),
+        )
+        .unwrap();
+        let syn = fi.synthesize(&active, 0.0).unwrap();
+        let mut s: Vec<f64> = syn.s.iter().map(|z| z.re).collect();
+        s.sort_by(f64::total_cmp);
+        // the lowest three synthesized eigenvalues against the exact ones
+        let err = (0..3)
+            .map(|i| (s[i] - exact[i]).abs() / exact[i])
+            .fold(0.0f64, f64::max);
+        errors.push(err);
+    }
+    assert!(errors[0] < 0.1, "6 modes: {errors:?}");
+    assert!(errors[2] < errors[0] * 0.5, "no convergence: {errors:?}");
+}
+
+#[test]
+fn expanded_modes_satisfy_the_ties_exactly() {
+    let (k, m) = model();
+    let fi = FreeInterface::new(
+        sparse(&k).as_ref(),
+        mass(&m).as_ref(),
+        &pairs(),
+        &modes(&k, &m, 12),
+    )
+    .unwrap();
+    let active = [1, 3];
+    let syn = fi.synthesize(&active, 0.5).unwrap();
+    let which: Vec<usize> = (0..syn.s.len()).collect();
+    let u = fi.expand(&syn, &which);
+    let pr = pairs();
+    for c in 0..which.len() {
+        let scale = (0..N).map(|i| u[(i, c)].norm()).fold(0.0f64, f64::max);
+        for &i in &active {
+            let gap = (u[(pr[i].pin[2], c)] - u[(pr[i].disc[2], c)]).norm();
+            assert!(
+                gap <= 1e-10 * scale,
+                "mode {c} pair {i}: gap {gap:e} of {scale:e}"
+            );
+        }
+    }
+    let w = fi.correction(&syn, &which).unwrap();
+    for c in 0..which.len() {
+        let scale = (0..N).map(|i| w[(i, c)].norm()).fold(0.0f64, f64::max);
+        for &i in &active {
+            let gap = (w[(pr[i].pin[2], c)] - w[(pr[i].disc[2], c)]).norm();
+            assert!(gap <= 1e-10 * scale, "correction {c} pair {i}: gap {gap:e}");
+        }
+    }
+    // and friction makes the synthesized pencil non-symmetric: some s may be complex,
+    // but conjugate pairs come together
+    let complex: Vec<&c64> = syn
+        .s
+        .iter()
+        .filter(|z| z.im.abs() > 1e-9 * z.norm())
+        .collect();
+    for z in &complex {
+        assert!(syn
+            .s
+            .iter()
+            .any(|w| (w - z.conj()).norm() <= 1e-9 * z.norm()));
+    }
+}
+
+#[test]
+fn bad_inputs_are_errors() {
+    let (k, m) = model();
+    let mut bad = modes(&k, &m, 5);
+    bad.omega2[0] = 0.0;
+    assert!(FreeInterface::new(sparse(&k).as_ref(), mass(&m).as_ref(), &pairs(), &bad).is_err());
+    assert!(FreeInterface::new(
+        sparse(&k).as_ref(),
+        mass(&m).as_ref(),
+        &[],
+        &modes(&k, &m, 5)
+    )
+    .is_err());
+    let fi = FreeInterface::new(
+        sparse(&k).as_ref(),
+        mass(&m).as_ref(),
+        &pairs(),
+        &modes(&k, &m, 5),
+    )
+    .unwrap();
+    assert!(fi.synthesize(&[7], 0.3).is_err());
+    assert!(fi.synthesize(&[0], f64::NAN).is_err());
+}

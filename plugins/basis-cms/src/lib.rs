@@ -1,0 +1,222 @@
+//! # squeal-basis-cms
+//!
+//! Free-interface component mode synthesis, registered as `"cms"`: a basis for the many
+//! contact sets of one model (mu sweeps whose contact set changes, macroscopic zones,
+//! mesoscopic plateau layouts) that costs no sparse eigen solve and no factorization per
+//! contact set.
+//!
+//! Once per model and set of candidate pairs the caller builds a
+//! [`FreeInterface`](squeal_core::FreeInterface) (normal modes of the unconstrained bodies
+//! up to `modes_factor x` the band top, static responses to unit contact loads and the
+//! residual contact flexibilities; [`squeal_core::synthesis`]). For each contact set and
+//! mu the basis then synthesizes the modes of the tied, frictional system by MacNeal's
+//! residual-flexibility method (an `m x m` eigenproblem, `m` free-interface modes, after
+//! one `nA x nA` LU), expands those up to `cutoff_factor x` the band top, and returns their
+//! real and imaginary parts, `M_c`-orthonormalized, as Ritz vectors of the exact operator:
+//! the shared reduced solve then refines them and gives every mode its backward error on
+//! the full operator.
+//!
+//! The synthesis is undamped (a damped operator is still projected whole); the basis
+//! depends on mu ([`ReductionBasis::depends_on_mu`] is `true`): it is rebuilt at every mu,
+//! which costs far less than one real-mode solve.
+//!
+//! ## Parameters
+//!
+//! - `modes_factor` (default 3, > 1): free-interface modes up to `modes_factor x` band top.
+//! - `cutoff_factor` (default 1.5, > 0): synthesized modes expanded up to
+//!   `cutoff_factor x` band top.
+//! - `second_order` (default 1 = on, 0 = off): add, for each expanded mode, its
+//!   second-order residual direction `G2 B_A^T r` (the inertia of the residual flexibility,
+//!   corrected statically onto the ties; [`FreeInterface::correction`]), which the Ritz
+//!   step uses to recover most of what the static residual flexibility leaves out.
+//! - `rank_tol` (default [`DEFAULT_RANK_TOL`]): relative rank cut of the
+//!   orthonormalization.
+//!
+//! [`FreeInterface::correction`]: squeal_core::FreeInterface::correction
+
+use squeal_core::faer::Mat;
+use squeal_core::reduction::{m_orthonormalize, DEFAULT_RANK_TOL};
+use squeal_core::{Basis, BasisRequest, Error, Params, ReductionBasis, Registry, Result};
+use std::time::Instant;
+
+/// Name under which the basis is registered.
+pub const NAME: &str = "cms";
+
+/// One-line description shown by the registry.
+pub const DESCRIPTION: &str = "free-interface modal synthesis with residual flexibility \
+                               (built once per model and candidate pairs), its modes up to \
+                               cutoff_factor x band top as Ritz vectors; options \
+                               modes_factor (3), cutoff_factor (1.5), second_order (1), rank_tol";
+
+/// Default of the `modes_factor` parameter.
+pub const DEFAULT_MODES_FACTOR: f64 = 3.0;
+/// Default of the `cutoff_factor` parameter.
+pub const DEFAULT_CUTOFF_FACTOR: f64 = 1.5;
+
+/// Registers the `"cms"` basis.
+pub fn register(reg: &mut Registry) {
+    reg.bases.register(NAME, DESCRIPTION, |params: &Params| {
+        params.reject_unknown(
+            NAME,
+            &["modes_factor", "cutoff_factor", "rank_tol", "second_order"],
+        )?;
+        let second_order = params.num_or("second_order", 1.0)?;
+        if second_order != 0.0 && second_order != 1.0 {
+            return Err(Error::param(
+                "second_order",
+                format!("must be 1 (on) or 0 (off), got {second_order}"),
+            ));
+        }
+        let basis: Box<dyn ReductionBasis> = Box::new(CmsBasis::new(
+            params.num_or("modes_factor", DEFAULT_MODES_FACTOR)?,
+            params.num_or("cutoff_factor", DEFAULT_CUTOFF_FACTOR)?,
+            params.num_or("rank_tol", DEFAULT_RANK_TOL)?,
+            second_order == 1.0,
+        )?);
+        Ok(basis)
+    });
+}
+
+/// The `"cms"` basis.
+#[derive(Debug, Clone)]
+pub struct CmsBasis {
+    /// Free-interface modes up to this factor times the band top.
+    pub modes_factor: f64,
+    /// Synthesized modes expanded up to this factor times the band top.
+    pub cutoff_factor: f64,
+    /// Relative rank cut of the orthonormalization.
+    pub rank_tol: f64,
+    /// Whether the second-order residual directions join the Ritz vectors.
+    pub second_order: bool,
+}
+
+impl CmsBasis {
+    /// Checks and stores the parameters.
+    pub fn new(
+        modes_factor: f64,
+        cutoff_factor: f64,
+        rank_tol: f64,
+        second_order: bool,
+    ) -> Result<Self> {
+        if !(modes_factor.is_finite() && modes_factor > 1.0) {
+            return Err(Error::param(
+                "modes_factor",
+                format!(
+                    "must be a number above 1 (free modes beyond the band), got {modes_factor}"
+                ),
+            ));
+        }
+        if !(cutoff_factor.is_finite() && cutoff_factor > 0.0) {
+            return Err(Error::param(
+                "cutoff_factor",
+                format!("must be a positive number, got {cutoff_factor}"),
+            ));
+        }
+        if !(rank_tol > 0.0 && rank_tol < 1.0) {
+            return Err(Error::param(
+                "rank_tol",
+                format!("must be in (0, 1), got {rank_tol}"),
+            ));
+        }
+        Ok(Self {
+            modes_factor,
+            cutoff_factor,
+            rank_tol,
+            second_order,
+        })
+    }
+}
+
+impl ReductionBasis for CmsBasis {
+    fn name(&self) -> &str {
+        NAME
+    }
+
+    fn depends_on_mu(&self) -> bool {
+        true
+    }
+
+    fn free_interface_cutoff(&self, band_top_hz: f64) -> Option<f64> {
+        Some(self.modes_factor * band_top_hz)
+    }
+
+    fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {
+        let start = Instant::now();
+        let free = request.free.ok_or_else(|| {
+            Error::Invalid(
+                "the `cms` basis needs the free-interface synthesis of the model, which the \
+                 scene-based commands (stability, sweep, studies, bench with a scene) build; \
+                 an operator read from files has none"
+                    .into(),
+            )
+        })?;
+        let op = request.op;
+        let active = free.active_in(op)?;
+        let syn = free.synthesize(&active, request.mu)?;
+        let cutoff = self.cutoff_factor * request.band_hz.1;
+        // one member of each conjugate pair of s (their expansions are conjugate)
+        let which: Vec<usize> = (0..syn.s.len())
+            .filter(|&k| syn.s[k].im >= 0.0 && syn.freq_hz(k) <= cutoff)
+            .collect();
+        if which.is_empty() {
+            return Err(Error::Invalid(format!(
+                "cms: no synthesized mode below {cutoff:.1} Hz"
+            )));
+        }
+        let mut u = free.expand(&syn, &which);
+        if self.second_order {
+            let w = free.correction(&syn, &which)?;
+            let k = u.ncols();
+            u = Mat::from_fn(u.nrows(), 2 * k, |i, c| {
+                if c < k {
+                    u[(i, c)]
+                } else {
+                    w[(i, c - k)]
+                }
+            });
+        }
+        let t = op.t.as_ref().expect("checked by active_in");
+        let nc = op.dim();
+        let mut cols: Vec<Vec<f64>> = Vec::with_capacity(2 * which.len());
+        for c in 0..u.ncols() {
+            let scale = (0..u.nrows())
+                .map(|i| u[(i, c)].norm())
+                .fold(0.0f64, f64::max);
+            let im = (0..u.nrows())
+                .map(|i| u[(i, c)].im.abs())
+                .fold(0.0f64, f64::max);
+            for part in 0..2 {
+                if part == 1 && im <= 1e-8 * scale {
+                    continue;
+                }
+                let mut v = vec![0.0; nc];
+                for (j, &tj) in t.iter().enumerate() {
+                    v[tj] = if part == 0 {
+                        u[(j, c)].re
+                    } else {
+                        u[(j, c)].im
+                    };
+                }
+                cols.push(v);
+            }
+        }
+        let raw = Mat::from_fn(nc, cols.len(), |i, c| cols[c][i]);
+        let (v, dropped) = m_orthonormalize(op.mc.as_ref(), raw.as_ref(), self.rank_tol)?;
+        let mut basis = Basis::new(v);
+        basis.dropped = dropped;
+        basis.mu = Some(request.mu);
+        basis.notes.push(format!(
+            "{NAME}: {} synthesized modes up to {cutoff:.1} Hz from {} free-interface modes \
+             (to {:.1} Hz) and {} tied pairs of {} candidates, {} vectors ({dropped} removed \
+             by the rank cut)",
+            which.len(),
+            free.modes(),
+            free.cutoff_hz,
+            active.len(),
+            free.pairs(),
+            basis.len()
+        ));
+        basis.time_s = start.elapsed().as_secs_f64();
+        Ok(basis)
+    }
+}

@@ -1,0 +1,196 @@
+//! The `cms` basis (free-interface modal synthesis with residual flexibility, built once
+//! per model and reused for every contact set) against full-order `arpack` on the coarse
+//! rig: the equilibrium contact sets of a mu sweep and imposed rectangular zones, the raw
+//! synthesis before the Ritz step, and the error without a synthesis.
+
+use squeal::analysis::pipeline::{damped_operator, Method, Prepared};
+use squeal::contact::ContactSet;
+use squeal::core::qep::ComplexModes;
+use squeal::core::{EigenParams, FrictionalOperator, Params, Registry};
+use squeal::scene::{Damping, Scene, Zone};
+
+const FMAX: f64 = 10_000.0;
+
+fn setup() -> (Registry, Prepared) {
+    let reg = squeal::registry();
+    let scene = Scene::builtin("pin-on-disc-coarse").unwrap();
+    let prep = Prepared::new(&reg, scene, "pin-on-disc-coarse").unwrap();
+    (reg, prep)
+}
+
+fn params() -> EigenParams {
+    EigenParams {
+        fmin_hz: 0.0,
+        fmax_hz: FMAX,
+        tol: 1e-12,
+        ..EigenParams::default()
+    }
+}
+
+fn full(reg: &Registry, op: &FrictionalOperator, mu: f64) -> ComplexModes {
+    let mut m = Method::new(reg, "none", &Params::new(), "arpack", "arpack", params()).unwrap();
+    m.solve(op, mu, true).unwrap().0
+}
+
+/// Largest relative frequency error and DvR error of `got` against `reference`, matching
+/// each reference mode to the nearest eigenvalue; both must have the same mode count.
+fn errors(reference: &ComplexModes, got: &ComplexModes) -> (f64, f64, f64) {
+    assert_eq!(
+        reference.len(),
+        got.len(),
+        "mode counts: reference {:?}, got {:?}",
+        reference.freq_hz,
+        got.freq_hz
+    );
+    let (mut df, mut ddvr, mut eta) = (0.0f64, 0.0f64, 0.0f64);
+    for i in 0..reference.len() {
+        let j = (0..got.len())
+            .min_by(|&a, &b| {
+                (got.lambda[a] - reference.lambda[i])
+                    .norm()
+                    .total_cmp(&(got.lambda[b] - reference.lambda[i]).norm())
+            })
+            .unwrap();
+        df = df.max((got.freq_hz[j] - reference.freq_hz[i]).abs() / reference.freq_hz[i]);
+        ddvr = ddvr.max((got.dvr[j] - reference.dvr[i]).abs());
+        eta = eta.max(got.backward_error[j]);
+    }
+    (df, ddvr, eta)
+}
+
+#[test]
+fn cms_matches_full_order_on_equilibrium_sets_and_zones() {
+    let (reg, prep) = setup();
+    let mut cms = Method::new(&reg, "cms", &Params::new(), "dense", "arpack", params()).unwrap();
+    let fi = cms
+        .prepare_free_interface(&prep.model, &prep.set)
+        .unwrap()
+        .expect("cms asks for a free-interface synthesis");
+    assert_eq!(fi.pairs(), prep.set.len());
+    // free modes up to 3 x the band top (the default modes_factor)
+    assert!(fi.cutoff_hz <= 3.0 * FMAX && fi.cutoff_hz > 2.0 * FMAX && fi.modes() > 10);
+    let mut unstable_seen = 0;
+    let mut check = |op: &FrictionalOperator, mu: f64, what: &str| {
+        let reference = full(&reg, op, mu);
+        let (got, size, _) = cms.solve(op, mu, true).unwrap();
+        let (df, ddvr, eta) = errors(&reference, &got);
+        let unstable = (0..reference.len())
+            .filter(|&i| reference.is_unstable(i, 1e-8))
+            .count();
+        unstable_seen += unstable;
+        println!(
+            "{what} mu {mu}: {} modes ({unstable} unstable), basis {size}, df/f {df:.1e}, \
+             dDvR {ddvr:.1e}, worst backward error {eta:.1e}",
+            reference.len()
+        );
+        assert!(df <= 2e-4, "{what} mu {mu}: df/f {df:e}");
+        assert!(ddvr <= 1e-4, "{what} mu {mu}: dDvR {ddvr:e}");
+        assert!(eta <= 1e-6, "{what} mu {mu}: backward error {eta:e}");
+    };
+    for mu in [0.3, 0.7, 1.0] {
+        let eq = prep.equilibrium(&reg, "lcp", "lagrange", mu).unwrap();
+        let op = prep.operator(&eq.eq.active).unwrap();
+        check(&op, mu, "equilibrium");
+    }
+    let zones = [(0.010, 0.003, 0.010, 0.014), (0.002, 0.002, 0.008, 0.008)];
+    for (x0_m, y0_m, a_m, b_m) in zones {
+        let zone = Zone::Rectangle {
+            x0_m,
+            y0_m,
+            a_m,
+            b_m,
+        };
+        let set = ContactSet::new(&prep.model, &zone, prep.scene.study.rotation).unwrap();
+        assert!(set.len() < prep.set.len());
+        let op = damped_operator(
+            &prep.model,
+            &Damping::default(),
+            &set,
+            &vec![true; set.len()],
+        )
+        .unwrap();
+        check(&op, 0.43, "zone");
+    }
+    assert!(
+        unstable_seen > 0,
+        "no unstable mode anywhere: the test would be weak"
+    );
+}
+
+#[test]
+fn the_raw_synthesis_is_close_before_the_ritz_step() {
+    let (reg, prep) = setup();
+    let mut cms = Method::new(&reg, "cms", &Params::new(), "dense", "arpack", params()).unwrap();
+    let fi = cms
+        .prepare_free_interface(&prep.model, &prep.set)
+        .unwrap()
+        .unwrap();
+    let mu = 0.7;
+    let eq = prep.equilibrium(&reg, "lcp", "lagrange", mu).unwrap();
+    let op = prep.operator(&eq.eq.active).unwrap();
+    let reference = full(&reg, &op, mu);
+    let active = fi.active_in(&op).unwrap();
+    assert_eq!(active.len(), eq.eq.active.iter().filter(|&&a| a).count());
+    let syn = fi.synthesize(&active, mu).unwrap();
+    let mut worst = 0.0f64;
+    for i in 0..reference.len() {
+        let nearest = (0..syn.s.len())
+            .map(|k| (syn.lambda(k) - reference.lambda[i]).norm())
+            .fold(f64::INFINITY, f64::min);
+        worst = worst.max(nearest / reference.lambda[i].norm());
+    }
+    println!(
+        "raw synthesis: worst |dlambda|/|lambda| {worst:.2e} over {} modes",
+        reference.len()
+    );
+    // the static residual flexibility is an approximation, but a close one
+    assert!(worst > 0.0 && worst < 2e-2, "{worst:e}");
+}
+
+#[test]
+fn cms_without_a_synthesis_is_a_clear_error() {
+    let (reg, prep) = setup();
+    let eq = prep.equilibrium(&reg, "lcp", "lagrange", 0.3).unwrap();
+    let op = prep.operator(&eq.eq.active).unwrap();
+    let mut cms = Method::new(&reg, "cms", &Params::new(), "dense", "arpack", params()).unwrap();
+    let err = cms.solve(&op, 0.3, true).unwrap_err().to_string();
+    assert!(err.contains("free-interface synthesis"), "{err}");
+    assert!(reg
+        .bases
+        .create(
+            "cms",
+            &Params::parse_kv("modes_factor=0.5")
+                .map(|(k, v)| {
+                    let mut p = Params::new();
+                    p.0.insert(k, v);
+                    p
+                })
+                .unwrap()
+        )
+        .is_err());
+}
+
+#[test]
+fn the_second_order_directions_sharpen_the_ritz_step() {
+    let (reg, prep) = setup();
+    let mu = 0.7;
+    let eq = prep.equilibrium(&reg, "lcp", "lagrange", mu).unwrap();
+    let op = prep.operator(&eq.eq.active).unwrap();
+    let reference = full(&reg, &op, mu);
+    let run = |second_order: f64| {
+        let mut p = Params::new();
+        let (k, v) = Params::parse_kv(&format!("second_order={second_order}")).unwrap();
+        p.0.insert(k, v);
+        let mut m = Method::new(&reg, "cms", &p, "dense", "arpack", params()).unwrap();
+        m.prepare_free_interface(&prep.model, &prep.set).unwrap();
+        let (got, size, _) = m.solve(&op, mu, true).unwrap();
+        let (df, ddvr, _) = errors(&reference, &got);
+        (df, ddvr, size)
+    };
+    let (df1, ddvr1, n1) = run(0.0);
+    let (df2, ddvr2, n2) = run(1.0);
+    println!("first order: df/f {df1:.1e} dDvR {ddvr1:.1e} ({n1} vectors); second order: df/f {df2:.1e} dDvR {ddvr2:.1e} ({n2} vectors)");
+    assert!(n2 > n1);
+    assert!(df2 < 0.5 * df1, "df/f {df2:e} vs {df1:e}");
+    assert!(ddvr2 < ddvr1, "dDvR {ddvr2:e} vs {ddvr1:e}");
+}
