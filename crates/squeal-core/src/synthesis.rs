@@ -372,14 +372,21 @@ impl FreeInterface {
     /// The unconstrained displacements `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r` of the
     /// synthesized modes `which` (`n x which.len()`).
     pub fn expand(&self, syn: &Synthesized, which: &[usize]) -> Mat<c64> {
-        let n = self.dofs();
+        let u = self.combine(syn, which, false);
+        let k = which.len();
+        Mat::from_fn(self.dofs(), k, |i, c| c64::new(u[(i, c)], u[(i, k + c)]))
+    }
+
+    /// `Phi e + (Y_n + mu Y_t) r` for the modes `which`, real and imaginary parts side by
+    /// side (`n x 2 which.len()`): with `second = false`, `e = eta - Omega^-2 Q^T r` and
+    /// `Y = K^-1 (Pn^T | Pt^T)` (the expansion); with `second = true`, `e = -Omega^-4 Q^T r`
+    /// and `Y = K^-1 M K^-1 (Pn^T | Pt^T)` (the second-order residual term).
+    fn combine(&self, syn: &Synthesized, which: &[usize], second: bool) -> Mat<f64> {
         let nm = self.modes();
-        let nr = self.pairs();
         let k = which.len();
         let mu = syn.mu;
-        // real and imaginary parts side by side: columns [re_0..re_k | im_0..im_k]
         let mut coef = Mat::<f64>::zeros(nm, 2 * k);
-        let mut rfull = Mat::<f64>::zeros(nr, 2 * k);
+        let mut rfull = Mat::<f64>::zeros(self.pairs(), 2 * k);
         for (c, &w) in which.iter().enumerate() {
             for (row, &i) in syn.active.iter().enumerate() {
                 let rv = syn.r[(row, w)];
@@ -391,12 +398,21 @@ impl FreeInterface {
                 for (row, &i) in syn.active.iter().enumerate() {
                     qtr += syn.r[(row, w)] * (self.pn_phi[(i, j)] + mu * self.pt_phi[(i, j)]);
                 }
-                let e = syn.eta[(j, w)] - qtr * (1.0 / self.omega2[j]);
+                let e = if second {
+                    qtr * (-1.0 / (self.omega2[j] * self.omega2[j]))
+                } else {
+                    syn.eta[(j, w)] - qtr * (1.0 / self.omega2[j])
+                };
                 coef[(j, c)] = e.re;
                 coef[(j, k + c)] = e.im;
             }
         }
-        let mut u = Mat::<f64>::zeros(n, 2 * k);
+        let (yn, yt) = if second {
+            (&self.yn, &self.yt)
+        } else {
+            (&self.zn, &self.zt)
+        };
+        let mut u = Mat::<f64>::zeros(self.dofs(), 2 * k);
         matmul(
             u.as_mut(),
             Accum::Replace,
@@ -408,7 +424,7 @@ impl FreeInterface {
         matmul(
             u.as_mut(),
             Accum::Add,
-            self.zn.as_ref(),
+            yn.as_ref(),
             rfull.as_ref(),
             1.0,
             par(),
@@ -417,13 +433,13 @@ impl FreeInterface {
             matmul(
                 u.as_mut(),
                 Accum::Add,
-                self.zt.as_ref(),
+                yt.as_ref(),
                 rfull.as_ref(),
                 mu,
                 par(),
             );
         }
-        Mat::from_fn(n, k, |i, c| c64::new(u[(i, c)], u[(i, k + c)]))
+        u
     }
 
     /// The second-order residual directions of the synthesized modes `which`:
@@ -434,56 +450,10 @@ impl FreeInterface {
     /// of the residual inertia.
     pub fn correction(&self, syn: &Synthesized, which: &[usize]) -> Result<Mat<c64>> {
         let n = self.dofs();
-        let nm = self.modes();
         let nr = self.pairs();
         let na = syn.active.len();
         let k = which.len();
-        let mu = syn.mu;
-        let mut coef = Mat::<f64>::zeros(nm, 2 * k);
-        let mut rfull = Mat::<f64>::zeros(nr, 2 * k);
-        for (c, &w) in which.iter().enumerate() {
-            for (row, &i) in syn.active.iter().enumerate() {
-                let rv = syn.r[(row, w)];
-                rfull[(i, c)] = rv.re;
-                rfull[(i, k + c)] = rv.im;
-            }
-            for j in 0..nm {
-                let mut qtr = c64::new(0.0, 0.0);
-                for (row, &i) in syn.active.iter().enumerate() {
-                    qtr += syn.r[(row, w)] * (self.pn_phi[(i, j)] + mu * self.pt_phi[(i, j)]);
-                }
-                let e = qtr * (-1.0 / (self.omega2[j] * self.omega2[j]));
-                coef[(j, c)] = e.re;
-                coef[(j, k + c)] = e.im;
-            }
-        }
-        let mut w = Mat::<f64>::zeros(n, 2 * k);
-        matmul(
-            w.as_mut(),
-            Accum::Replace,
-            self.phi.as_ref(),
-            coef.as_ref(),
-            1.0,
-            par(),
-        );
-        matmul(
-            w.as_mut(),
-            Accum::Add,
-            self.yn.as_ref(),
-            rfull.as_ref(),
-            1.0,
-            par(),
-        );
-        if mu != 0.0 {
-            matmul(
-                w.as_mut(),
-                Accum::Add,
-                self.yt.as_ref(),
-                rfull.as_ref(),
-                mu,
-                par(),
-            );
-        }
+        let mut w = self.combine(syn, which, true);
         if na > 0 {
             // static correction onto the ties: c = W_AA^-1 Pn_A w, w -= K^-1 Pn_A^T c
             let waa = Mat::from_fn(na, na, |i, j| self.wfull[(syn.active[i], syn.active[j])]);
