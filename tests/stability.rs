@@ -164,7 +164,7 @@ fn backends_agree_on_a_coarse_scene_and_export_round_trips() {
 }
 
 /// The default rig on the previous size rule (10 per wavelength, 2 layers, grading 1.5:
-/// about 60k DOFs, on the low-rank path): the default rule's 153k DOFs would cost this
+/// about 60k DOFs, on the low-rank path): the default rule's 173k DOFs would cost this
 /// test about 10 minutes of CI's 30 on two cores, and the solvers' agreement does not
 /// depend on the mesh density.
 #[test]
@@ -176,6 +176,7 @@ fn arpack_and_krylov_agree_on_the_default_scene() {
         scene.mesh.min_layers,
         scene.mesh.grading_ratio,
     ) = (10.0, 2, 1.5);
+    scene.mesh.plate_elements_per_wavelength = None;
     let prep = Prepared::new(&reg, scene, "default, previous rule").unwrap();
     for mu in [0.3, 0.7] {
         let eq = prep.equilibrium(&reg, "lcp", "lagrange", mu).unwrap();

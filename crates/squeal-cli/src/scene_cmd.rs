@@ -11,10 +11,12 @@ pub fn info(registry: &Registry, scene: &Scene, file: &str) -> Result<()> {
     let r = &scene.mesh;
     println!("scene `{}` ({file})", scene.name);
     println!(
-        "rule: element edge <= bending wavelength at {} Hz / {}, >= {} layers per thickness, \
+        "rule: element edge <= bending wavelength at {} Hz / {}{}, >= {} layers per thickness, \
          pin face {} x {} elements, grading ratio {} away from the contact patch",
         r.max_freq_hz,
         r.elements_per_wavelength,
+        r.plate_elements_per_wavelength
+            .map_or(String::new(), |p| format!(" (plates / {p})")),
         r.min_layers,
         r.pin_face_elements,
         r.pin_face_elements,

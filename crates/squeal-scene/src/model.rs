@@ -896,7 +896,8 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
                 m.as_ref(),
                 pl.thickness_m,
                 rule.max_freq_hz,
-                rule.elements_per_wavelength,
+                rule.plate_elements_per_wavelength
+                    .unwrap_or(rule.elements_per_wavelength),
             );
             h_plate = h_plate.min(h);
             plate_mats.push((m, lambda, h));

@@ -291,6 +291,10 @@ pub struct MeshRule {
     pub max_freq_hz: f64,
     /// Elements per bending wavelength at `max_freq_hz`.
     pub elements_per_wavelength: f64,
+    /// Elements per bending wavelength of the thin and thick plates, when they need a
+    /// finer rule than the other bodies; `None`: `elements_per_wavelength`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plate_elements_per_wavelength: Option<f64>,
     /// Minimum element layers through any thickness.
     pub min_layers: usize,
     /// Elements along each side of the pin face (the contact grid has
@@ -305,6 +309,7 @@ impl Default for MeshRule {
         Self {
             max_freq_hz: 10_500.0,
             elements_per_wavelength: 15.0,
+            plate_elements_per_wavelength: None,
             min_layers: 4,
             pin_face_elements: 20,
             grading_ratio: 1.25,
@@ -917,6 +922,14 @@ impl Scene {
                 "mesh.elements_per_wavelength",
                 format!("expected a number >= 2, got {}", m.elements_per_wavelength),
             ));
+        }
+        if let Some(p) = m.plate_elements_per_wavelength {
+            if !(p.is_finite() && p >= 2.0) {
+                return Err(field(
+                    "mesh.plate_elements_per_wavelength",
+                    format!("expected a number >= 2, got {p}"),
+                ));
+            }
         }
         if m.min_layers == 0 || m.pin_face_elements == 0 {
             return Err(field(

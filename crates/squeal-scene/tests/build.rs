@@ -101,6 +101,8 @@ fn bad_scenes_name_their_field() {
     band.study.band_hz = [5000.0, 1000.0];
     let mut grading = base.clone();
     grading.mesh.grading_ratio = 5.0;
+    let mut plates = base.clone();
+    plates.mesh.plate_elements_per_wavelength = Some(1.0);
     let cases = [
         (thin.to_toml(), "disc.thickness_m"),
         (outside.to_toml(), "pin.center_radius_m"),
@@ -111,6 +113,7 @@ fn bad_scenes_name_their_field() {
         (mu.to_toml(), "study.mu"),
         (band.to_toml(), "study.band_hz"),
         (grading.to_toml(), "mesh.grading_ratio"),
+        (plates.to_toml(), "mesh.plate_elements_per_wavelength"),
     ];
     for (bad, field) in cases {
         let e = Scene::from_toml(&bad, "bad.toml").unwrap_err().to_string();
