@@ -161,26 +161,23 @@ impl FreeInterface {
                 zt[(p.disc[a], j)] -= p.direction[a];
             }
         }
-        const BLOCK: usize = 64;
-        for z in [&mut zn, &mut zt] {
+        // K^-1 in place on the columns of `x`, in blocks
+        let solve_blocks = |x: &mut Mat<f64>| {
+            const BLOCK: usize = 64;
             let mut c0 = 0;
             while c0 < nr {
                 let b = BLOCK.min(nr - c0);
-                factor.solve_in_place(z.as_mut().subcols_mut(c0, b));
+                factor.solve_in_place(x.as_mut().subcols_mut(c0, b));
                 c0 += b;
             }
-        }
+        };
+        solve_blocks(&mut zn);
+        solve_blocks(&mut zt);
         // second-order residual terms K^-1 M K^-1 (Pn^T | Pt^T)
         let mut yn = crate::reduction::sparse_times(m, zn.as_ref());
         let mut yt = crate::reduction::sparse_times(m, zt.as_ref());
-        for y in [&mut yn, &mut yt] {
-            let mut c0 = 0;
-            while c0 < nr {
-                let b = BLOCK.min(nr - c0);
-                factor.solve_in_place(y.as_mut().subcols_mut(c0, b));
-                c0 += b;
-            }
-        }
+        solve_blocks(&mut yn);
+        solve_blocks(&mut yt);
         let pn_rows = |x: MatRef<'_, f64>| {
             Mat::from_fn(nr, x.ncols(), |i, c| {
                 x[(pairs[i].pin[2], c)] - x[(pairs[i].disc[2], c)]
