@@ -1,6 +1,7 @@
-//! How the default disc's dimensions were chosen: a Nelder-Mead fit of the disc ring
-//! and its hat (ring inner and outer radius, ring thickness, hat height, hat wall
-//! thickness, hat radius) to the paper's Table 2.
+//! A fit of the disc ring and its hat (ring inner and outer radius, ring thickness, hat
+//! height, hat wall thickness, hat radius) to the paper's Table 2: Nelder-Mead here, and
+//! the evaluator behind `scripts/disc_fit_lp.py`, the sequential linear program that
+//! gave the default disc (session 8: 16 of 16 labels within 5 %).
 //!
 //! Run: `cargo run --release --example disc_fit -- [r_in R h hat_height hat_wall hat_radius]`
 //! With `SQUEAL_FIT_FAMILY=flange` the hat's lower end is closed by an annular plate
@@ -162,7 +163,7 @@ fn main() {
         (false, 6) | (true, 8) => args,
         (false, _) => vec![0.07, 0.15, 0.02, 0.03, 0.004, 0.07],
         (true, _) => vec![
-            0.0679, 0.1446, 0.0142, 0.0174, 0.0036, 0.0679, 0.0629, 0.0106,
+            0.0677, 0.1324, 0.0118, 0.0111, 0.0018, 0.0677, 0.0575, 0.0073,
         ],
     };
     // with SQUEAL_FIT_CORRECT=1 the search runs on its (coarser) rule with each label's

@@ -17,7 +17,7 @@ use squeal_core::{
 use squeal_scene::Scene;
 use std::time::Instant;
 
-const FMAX: f64 = 3000.0;
+const FMAX: f64 = 3500.0;
 
 fn registry() -> Registry {
     let mut reg = Registry::new();
