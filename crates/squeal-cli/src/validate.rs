@@ -21,6 +21,8 @@ pub struct Args<'a> {
     pub scene: Option<&'a str>,
     pub out: &'a Path,
     pub step: f64,
+    /// Band (Hz) of the sweeps and the reference points.
+    pub band: [f64; 2],
     pub bases: &'a [String],
     pub reference_mu: &'a [f64],
     pub eigen: &'a str,
@@ -149,7 +151,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
             eigen: "dense",
             basis,
             basis_opts: &[],
-            band: scene.study.band_hz,
+            band: a.band,
             equilibrium: "lcp",
             law: "lagrange",
             dvr_tol: 1e-6,
@@ -178,8 +180,8 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
     eprintln!("[4/4] full-order reference points");
     let prep = Prepared::new(registry, scene.clone(), &file)?;
     let params = EigenParams {
-        fmin_hz: scene.study.band_hz[0],
-        fmax_hz: scene.study.band_hz[1],
+        fmin_hz: a.band[0],
+        fmax_hz: a.band[1],
         tol: 1e-10,
         ..EigenParams::default()
     };
@@ -236,8 +238,8 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
     // report
     let _ = writeln!(
         md,
-        "## 3. Friction sweep mu = 0 ... 0.8 (step {})\n",
-        a.step
+        "## 3. Friction sweep mu = 0 ... 0.8 (step {}, band {:.0}-{:.0} Hz)\n",
+        a.step, a.band[0], a.band[1]
     );
     for (basis, s) in &summaries {
         let _ = writeln!(
@@ -309,6 +311,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
         "scene": file,
         "units": "SI: Hz, N, m, s; DvR = Re/Im",
         "table2": rows,
+        "band_hz": a.band,
         "equilibrium": eqs,
         "sweeps": summaries.iter().map(|(b, s)| serde_json::json!({"basis": b, "summary": s})).collect::<Vec<_>>(),
         "reference": refs,
