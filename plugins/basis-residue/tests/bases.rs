@@ -1,5 +1,6 @@
 //! The three built-in bases against a full-order reference on a coarse build of the
-//! default pin-on-disc scene (band 0-3000 Hz), at mu = 0.3 and 0.55 (a flutter pair near 2190 Hz at 0.45-0.65):
+//! default pin-on-disc scene with a 3 mm thin plate (band 0-3500 Hz), at mu = 0.3 and 0.55
+//! (a flutter pair near 2190 Hz from mu about 0.45):
 //!
 //! - `enriched` and `residue` reproduce every reference mode in the band (frequency error
 //!   <= 0.1 %, |DvR error| <= 1e-4), find every unstable mode and no false one;
@@ -32,10 +33,17 @@ fn registry() -> Registry {
     reg
 }
 
+/// The default rig, coarsened, with the 3 mm thin plate of sessions 6-7: on it the
+/// 2100 Hz flutter pair starts below mu = 0.55. (The default's 3.5 mm plate, tuned to the
+/// paper's mu, moves the onset past 0.65; the bases are what is tested here, not the rig.)
 fn coarse() -> Scene {
     let mut s = Scene::builtin("pin-on-disc").unwrap();
     s.mesh.max_freq_hz = 4000.0;
     s.mesh.pin_face_elements = 6;
+    s.thin_plate
+        .as_mut()
+        .expect("the default scene has a thin plate")
+        .thickness_m = 0.003;
     s
 }
 
