@@ -34,33 +34,43 @@ import sys
 import numpy as np
 from scipy.optimize import linprog
 
-LABELS = ["a,0,0", "a,0,1", "a,0,2", "a,0,3", "c,0", "c,1", "a,0,4", "r,2",
-          "a,0,5", "a,0,6", "a,1,0", "a,1,1", "r,3", "r,0", "a,1,2", "a,0,7"]
-PAPER = np.array([892.3, 912.2, 1261.0, 2220.0, 3108.0, 3324.0, 3694.0, 4735.0,
-                  5571.0, 7776.0, 7873.0, 8596.0, 8634.0, 9122.0, 9648.0, 10250.0])
 NAMES = ["r_in", "R", "h", "hat_h", "hat_t", "hat_r", "fl_bore", "fl_t"]
 BIN = "target/release/examples/disc_fit"
-IA, IR = LABELS.index("a,1,0"), LABELS.index("r,0")
+# Table 2's labels and frequencies, in the order the example prints them (squeal's own
+# table, `squeal_analysis::modal::TABLE2`): filled by the first evaluation
+LABELS = []
+PAPER = np.array([])
 
 
 def evaluate(x, coarse):
     """The 16 frequencies (Hz, NaN when a label is missing), a,1,0 / r,0 sorted."""
+    global LABELS, PAPER
     env = dict(os.environ, SQUEAL_FIT_EVAL="1", SQUEAL_FIT_FAMILY="flange")
     if coarse:
         env.update(SQUEAL_FIT_EPW="10", SQUEAL_FIT_LAYERS="3")
     out = subprocess.run([BIN] + [f"{v:.6f}" for v in x], env=env,
                          capture_output=True, text=True, check=True).stdout
-    found = {}
+    rows = []  # (label, paper Hz, squeal Hz) for each table row
     for line in out.splitlines():
         p = line.split()
-        if len(p) >= 3 and p[0] in LABELS:
+        if len(p) >= 3 and p[0].count(",") in (1, 2) and p[0][0] in "acr":
             try:
-                found[p[0]] = float(p[2])
+                paper = float(p[1])
             except ValueError:
-                pass
+                continue
+            try:
+                squeal = float(p[2])
+            except ValueError:
+                squeal = np.nan
+            rows.append((p[0], paper, squeal))
+    if not LABELS:
+        LABELS = [r[0] for r in rows]
+        PAPER = np.array([r[1] for r in rows])
+    found = {r[0]: r[2] for r in rows}
     f = np.array([found.get(l, np.nan) for l in LABELS])
-    if f[IA] > f[IR]:
-        f[IA], f[IR] = f[IR], f[IA]
+    ia, ir = LABELS.index("a,1,0"), LABELS.index("r,0")
+    if f[ia] > f[ir]:
+        f[ia], f[ir] = f[ir], f[ia]
     return f
 
 
