@@ -7,6 +7,7 @@
 //! - `cantilever`: bending frequencies of a slender clamped beam against Euler-Bernoulli;
 //! - `solvers_agree`: `arpack` and `krylov` agree on the default scene's disc, whose
 //!   `n > 0` modes come in doublets;
+//! - `ties`: a fine block tied to a coarse one acts as one body;
 //! - `pin`: the pin assembly of the default scene has a handful of modes below 10 kHz.
 
 #[path = "fe/common.rs"]
@@ -26,3 +27,6 @@ mod solvers_agree;
 
 #[path = "fe/pin.rs"]
 mod pin;
+
+#[path = "fe/ties.rs"]
+mod ties;

@@ -4,9 +4,10 @@
 //! nodes sharing an element, eliminated DOFs left out). Elements are then split into one
 //! chunk per worker thread; each chunk scatters its element matrices into a private
 //! value array (binary search of the row in the column), and the arrays are summed.
-//! Memory: one value array (8 bytes x nnz) per worker and matrix.
+//! Memory: one value array (8 bytes x nnz) per worker and matrix. A tied node's entries
+//! go to its masters' DOFs, times their weights (`T^T K_e T`).
 
-use crate::dofs::{node_graph, DofMap};
+use crate::dofs::{tied_node_graph, DofMap};
 use crate::hex8::hex8_matrices;
 use crate::mesh::Mesh;
 use rayon::prelude::*;
@@ -28,7 +29,7 @@ pub struct Assembled {
 
 /// The symbolic pattern on the free DOFs: `(col_ptr, row_idx)`, rows sorted.
 pub fn pattern(mesh: &Mesh, dofs: &DofMap) -> (Vec<usize>, Vec<usize>) {
-    let adj = node_graph(mesh);
+    let adj = tied_node_graph(mesh, &dofs.node_ties());
     let n = dofs.n_free();
     let mut col_ptr = Vec::with_capacity(n + 1);
     let mut row_idx = Vec::new();
@@ -62,6 +63,10 @@ pub fn assemble(mesh: &Mesh, dofs: &DofMap, materials: &[&dyn Material]) -> Resu
         .iter()
         .map(|m| (m.elasticity(), m.density()))
         .collect();
+    let mut has_tie = vec![false; mesh.n_nodes()];
+    for (d, _) in &dofs.tied {
+        has_tie[d / 3] = true;
+    }
     let threads = rayon::current_num_threads().max(1);
     let chunk = mesh.hexes.len().div_ceil(threads).max(1);
     let parts: Vec<(Vec<f64>, Vec<f64>, f64, f64)> = (0..mesh.hexes.len())
@@ -72,11 +77,34 @@ pub fn assemble(mesh: &Mesh, dofs: &DofMap, materials: &[&dyn Material]) -> Resu
             let mut mv = vec![0.0; nnz];
             let mut mass = 0.0;
             let mut min_det = f64::INFINITY;
+            let mut buf = Vec::new();
+            let mut lists: Vec<Vec<(usize, f64)>> = vec![Vec::new(); 24];
             for &e in elems {
                 let (d, rho) = &props[mesh.hex_body[e]];
                 let em = hex8_matrices(&mesh.hex_coords(e), d, *rho);
                 mass += rho * em.volume;
                 min_det = min_det.min(em.min_det_j);
+                if mesh.hexes[e].iter().any(|&n| has_tie[n]) {
+                    // T^T K_e T: each local DOF follows a list of free DOFs
+                    for (a, l) in lists.iter_mut().enumerate() {
+                        dofs.follows(3 * mesh.hexes[e][a / 3] + a % 3, &mut buf);
+                        l.clone_from(&buf);
+                    }
+                    for (b, lb) in lists.iter().enumerate() {
+                        for &(col, wb) in lb {
+                            let rows = &row_idx[col_ptr[col]..col_ptr[col + 1]];
+                            for (a, la) in lists.iter().enumerate() {
+                                for &(row, wa) in la {
+                                    let pos =
+                                        col_ptr[col] + rows.binary_search(&row).expect("pattern");
+                                    kv[pos] += wa * wb * em.ke[a][b];
+                                    mv[pos] += wa * wb * em.me[a][b];
+                                }
+                            }
+                        }
+                    }
+                    continue;
+                }
                 let free: [Option<usize>; 24] =
                     std::array::from_fn(|a| dofs.free_of_full[3 * mesh.hexes[e][a / 3] + a % 3]);
                 for (b, fb) in free.iter().enumerate() {

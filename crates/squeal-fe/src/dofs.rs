@@ -1,19 +1,52 @@
 //! DOF numbering: reverse Cuthill-McKee on the node graph, three DOFs per node
-//! interleaved, and Dirichlet conditions by elimination.
+//! interleaved, Dirichlet conditions and node ties by elimination.
 //!
 //! RCM (Cuthill & McKee 1969, George 1971) gives a small profile, so fill stays low for
 //! any factorization; faer's Cholesky further reorders with AMD. Eliminated DOFs are
 //! simply not numbered: the assembled matrices live on the free DOFs only.
+//!
+//! A [`Tie`] makes a node move as a weighted sum of other nodes (a hanging node of a fine
+//! mesh on a coarse element face, weights the coarse face's shape functions there). Its
+//! DOFs are eliminated too (master-slave elimination, `u = T q`): the assembly scatters
+//! its element entries onto the masters' DOFs, so the matrices are `T^T K T`.
 
 use crate::mesh::Mesh;
 use std::collections::VecDeque;
 
+/// A node tied to others: `u(slave) = sum_k w_k u(master_k)`, each component alike.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tie {
+    /// The tied (hanging) node.
+    pub slave: usize,
+    /// Master nodes and weights (the weights of an interpolation sum to 1).
+    pub masters: Vec<(usize, f64)>,
+}
+
 /// Sorted node adjacency lists (nodes sharing an element), self excluded.
 pub fn node_graph(mesh: &Mesh) -> Vec<Vec<usize>> {
+    tied_node_graph(mesh, &[])
+}
+
+/// [`node_graph`] after the ties' elimination: a tied node is replaced by its masters in
+/// every element (so they become neighbours of the element's other nodes) and has no
+/// neighbour itself.
+pub fn tied_node_graph(mesh: &Mesh, ties: &[Tie]) -> Vec<Vec<usize>> {
+    let mut sub: Vec<Option<&[(usize, f64)]>> = vec![None; mesh.n_nodes()];
+    for t in ties {
+        sub[t.slave] = Some(&t.masters);
+    }
     let mut adj: Vec<Vec<usize>> = vec![Vec::new(); mesh.n_nodes()];
+    let mut eff: Vec<usize> = Vec::with_capacity(32);
     for h in &mesh.hexes {
+        eff.clear();
         for &a in h {
-            for &b in h {
+            match sub[a] {
+                Some(ms) => eff.extend(ms.iter().map(|m| m.0)),
+                None => eff.push(a),
+            }
+        }
+        for &a in &eff {
+            for &b in &eff {
                 if a != b {
                     adj[a].push(b);
                 }
@@ -104,13 +137,52 @@ pub struct DofMap {
     pub free_of_full: Vec<Option<usize>>,
     /// Full DOF of each free index.
     pub full_of_free: Vec<usize>,
+    /// Tied full DOFs (their `free_of_full` is `None`) and the free DOFs and weights they
+    /// follow, sorted by full DOF. Empty without ties.
+    pub tied: Vec<(usize, Vec<(usize, f64)>)>,
 }
 
 impl DofMap {
     /// Numbers the DOFs of `mesh` in RCM node order, three per node, skipping the
     /// `fixed` full DOFs (Dirichlet by elimination). Nodes used by no element get no DOF.
     pub fn new(mesh: &Mesh, fixed: &[usize]) -> DofMap {
-        let adj = node_graph(mesh);
+        Self::with_ties(mesh, fixed, &[]).expect("no ties, nothing to check")
+    }
+
+    /// [`DofMap::new`] with the tied nodes `ties` eliminated as well. A tied component
+    /// that is also fixed stays fixed; fixed masters contribute nothing. A node tied
+    /// twice, a master that is itself tied, a weight that is not finite or a node out of
+    /// range is an error message.
+    pub fn with_ties(mesh: &Mesh, fixed: &[usize], ties: &[Tie]) -> Result<DofMap, String> {
+        let nn = mesh.n_nodes();
+        let mut is_slave = vec![false; nn];
+        for t in ties {
+            if t.slave >= nn || t.masters.iter().any(|m| m.0 >= nn) {
+                return Err(format!(
+                    "tie of node {} names a node beyond the mesh's {nn}",
+                    t.slave
+                ));
+            }
+            if std::mem::replace(&mut is_slave[t.slave], true) {
+                return Err(format!("node {} is tied twice", t.slave));
+            }
+            if t.masters.is_empty() || t.masters.iter().any(|m| !m.1.is_finite()) {
+                return Err(format!(
+                    "tie of node {}: expected masters with finite weights, got {:?}",
+                    t.slave, t.masters
+                ));
+            }
+        }
+        if let Some(t) = ties
+            .iter()
+            .find(|t| t.masters.iter().any(|m| is_slave[m.0]))
+        {
+            return Err(format!(
+                "node {} is tied to a node that is tied itself (chains are not supported)",
+                t.slave
+            ));
+        }
+        let adj = tied_node_graph(mesh, ties);
         let order = rcm_order(&adj);
         let n_full = 3 * mesh.n_nodes();
         let mut is_fixed = vec![false; n_full];
@@ -131,9 +203,64 @@ impl DofMap {
                 }
             }
         }
-        DofMap {
+        let mut tied = Vec::new();
+        for t in ties {
+            for c in 0..3 {
+                let d = 3 * t.slave + c;
+                if is_fixed[d] {
+                    continue;
+                }
+                let to: Vec<(usize, f64)> = t
+                    .masters
+                    .iter()
+                    .filter_map(|&(m, w)| free_of_full[3 * m + c].map(|f| (f, w)))
+                    .collect();
+                tied.push((d, to));
+            }
+        }
+        tied.sort_by_key(|t| t.0);
+        Ok(DofMap {
             free_of_full,
             full_of_free,
+            tied,
+        })
+    }
+
+    /// The node-level ties behind [`DofMap::tied`] (masters that have a free DOF; the
+    /// weights of the first tied component), for graphs and patterns.
+    pub fn node_ties(&self) -> Vec<Tie> {
+        let mut out: Vec<Tie> = Vec::new();
+        for (d, to) in &self.tied {
+            let slave = d / 3;
+            let masters = to.iter().map(|&(f, w)| (self.full_of_free[f] / 3, w));
+            match out.last_mut() {
+                Some(t) if t.slave == slave => {
+                    for (m, w) in masters {
+                        if !t.masters.iter().any(|x| x.0 == m) {
+                            t.masters.push((m, w));
+                        }
+                    }
+                }
+                _ => out.push(Tie {
+                    slave,
+                    masters: masters.collect(),
+                }),
+            }
+        }
+        out
+    }
+
+    /// The free DOFs and weights full DOF `d` follows: itself, its masters' (tied), or
+    /// none (fixed). `buf` is cleared and filled.
+    pub fn follows(&self, d: usize, buf: &mut Vec<(usize, f64)>) {
+        buf.clear();
+        match self.free_of_full[d] {
+            Some(f) => buf.push((f, 1.0)),
+            None => {
+                if let Ok(k) = self.tied.binary_search_by_key(&d, |t| t.0) {
+                    buf.extend_from_slice(&self.tied[k].1);
+                }
+            }
         }
     }
 
@@ -150,11 +277,15 @@ impl DofMap {
         self.full_of_free.len()
     }
 
-    /// Scatters a free-DOF vector to full DOFs (eliminated DOFs get 0).
+    /// Scatters a free-DOF vector to full DOFs: fixed DOFs get 0, tied DOFs their
+    /// masters' weighted sum.
     pub fn expand(&self, free: &[f64]) -> Vec<f64> {
         let mut full = vec![0.0; self.free_of_full.len()];
         for (i, &d) in self.full_of_free.iter().enumerate() {
             full[d] = free[i];
+        }
+        for (d, to) in &self.tied {
+            full[*d] = to.iter().map(|&(f, w)| w * free[f]).sum();
         }
         full
     }

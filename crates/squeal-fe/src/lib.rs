@@ -10,5 +10,5 @@ pub mod hex8;
 pub mod mesh;
 
 pub use assembly::{assemble, Assembled};
-pub use dofs::DofMap;
+pub use dofs::{DofMap, Tie};
 pub use mesh::Mesh;

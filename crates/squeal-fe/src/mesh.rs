@@ -99,6 +99,82 @@ pub fn hex_volume(x: &[[f64; 3]; 8]) -> f64 {
     vol
 }
 
+/// Ties the nodes `slaves` to a face of a coarser mesh: the `masters` nodes, which form a
+/// tensor grid on the lines `xs` x `ys` (increasing, one node per intersection, to `1e-9`
+/// of the grid's size in x and y), one plane of it. Each slave gets the bilinear weights
+/// of the grid cell over its (x, y) (one weight 1 where it sits on a master). A slave
+/// outside the grid, or a grid intersection without a master node, is an error message.
+pub fn face_ties(
+    mesh: &Mesh,
+    slaves: &[usize],
+    masters: &[usize],
+    xs: &[f64],
+    ys: &[f64],
+) -> Result<Vec<crate::dofs::Tie>, String> {
+    let (nx, ny) = (xs.len(), ys.len());
+    if nx < 2 || ny < 2 {
+        return Err(format!("a master grid needs 2 x 2 lines, got {nx} x {ny}"));
+    }
+    let size = (xs[nx - 1] - xs[0]).max(ys[ny - 1] - ys[0]);
+    let tol = 1e-9 * size;
+    let line = |v: &[f64], x: f64| {
+        let i = v.partition_point(|&l| l < x - tol);
+        (i < v.len() && (v[i] - x).abs() <= tol).then_some(i)
+    };
+    let mut at = vec![usize::MAX; nx * ny];
+    for &m in masters {
+        let p = mesh.nodes[m];
+        if let (Some(i), Some(j)) = (line(xs, p[0]), line(ys, p[1])) {
+            at[j * nx + i] = m;
+        }
+    }
+    if let Some(k) = at.iter().position(|&m| m == usize::MAX) {
+        return Err(format!(
+            "no master node at grid point ({:e}, {:e}) m",
+            xs[k % nx],
+            ys[k / nx]
+        ));
+    }
+    // cell index and local coordinate in [0, 1] along one axis
+    let cell = |v: &[f64], x: f64| -> Option<(usize, f64)> {
+        if x < v[0] - tol || x > v[v.len() - 1] + tol {
+            return None;
+        }
+        let i = (v.partition_point(|&l| l <= x).max(1) - 1).min(v.len() - 2);
+        Some((i, ((x - v[i]) / (v[i + 1] - v[i])).clamp(0.0, 1.0)))
+    };
+    slaves
+        .iter()
+        .map(|&s| {
+            let p = mesh.nodes[s];
+            let (Some((i, u)), Some((j, v))) = (cell(xs, p[0]), cell(ys, p[1])) else {
+                return Err(format!(
+                    "node {s} at ({:e}, {:e}) m lies outside the master grid [{:e}, {:e}] x \
+                     [{:e}, {:e}] m",
+                    p[0],
+                    p[1],
+                    xs[0],
+                    xs[nx - 1],
+                    ys[0],
+                    ys[ny - 1]
+                ));
+            };
+            let w = [
+                (i, j, (1.0 - u) * (1.0 - v)),
+                (i + 1, j, u * (1.0 - v)),
+                (i, j + 1, (1.0 - u) * v),
+                (i + 1, j + 1, u * v),
+            ];
+            let masters = w
+                .iter()
+                .filter(|c| c.2.abs() > 1e-12)
+                .map(|&(a, b, wt)| (at[b * nx + a], wt))
+                .collect();
+            Ok(crate::dofs::Tie { slave: s, masters })
+        })
+        .collect()
+}
+
 impl Mesh {
     /// Number of nodes.
     pub fn n_nodes(&self) -> usize {
