@@ -8,6 +8,7 @@
 //! - `solvers_agree`: `arpack` and `krylov` agree on the default scene's disc, whose
 //!   `n > 0` modes come in doublets;
 //! - `ties`: a fine block tied to a coarse one acts as one body;
+//! - `refine`: contact refinement by tied contact layers keeps the rig;
 //! - `pin`: the pin assembly of the default scene has a handful of modes below 10 kHz.
 
 #[path = "fe/common.rs"]
@@ -30,3 +31,6 @@ mod pin;
 
 #[path = "fe/ties.rs"]
 mod ties;
+
+#[path = "fe/refine.rs"]
+mod refine;

@@ -12,11 +12,13 @@
 //!
 //! The ties give `r = -S^-1 P eta` with `S = Pn_A G B_A^T` (`nA x nA`) and `P = Pn_A Phi`,
 //! hence the `m x m` standard eigenproblem `lambda^2 eta = -(Omega^2 + Q^T S^-1 P) eta`,
-//! `Q = B_A Phi`, whatever the number of pairs. The columns `K^-1 Pn^T`, `K^-1 Pt^T` of
-//! every candidate pair and the residual contact flexibilities `Pn G Pn^T`, `Pn G Pt^T`
-//! are computed once (one Cholesky factorization of `K`, `2 nR` solves): a new contact set
-//! or mu then costs one `nA x nA` LU, one `m x m` eigen decomposition and the expansion
-//! `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r`, which satisfies `Pn_A u = 0` exactly.
+//! `Q = B_A Phi`, whatever the number of pairs. The residual contact flexibilities
+//! `Pn G Pn^T`, `Pn G Pt^T` of the candidate pairs are computed once (one Cholesky
+//! factorization of `K`, kept, and `2 nR` solves whose pair rows alone are kept, so the
+//! memory is `O(nR^2)`, not `O(n nR)`): a new contact set or mu then costs one
+//! `nA x nA` LU, one `m x m` eigen decomposition and the expansion
+//! `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r` (one block solve for the modes
+//! expanded), which satisfies `Pn_A u = 0` exactly.
 //!
 //! The residual flexibility is static (its inertia is neglected), so the synthesized modes
 //! are approximations whose error falls with the ratio of the band to the modal cutoff;
@@ -28,7 +30,7 @@
 use crate::contact::FrictionalOperator;
 use crate::eigen::RealModes;
 use crate::linalg::Cholesky;
-use crate::{c64, Error, Result, SparseRef};
+use crate::{c64, Error, Result, SparseMat, SparseRef};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef, Par};
 use std::time::Instant;
@@ -50,13 +52,11 @@ pub struct FreeInterface {
     pairs: Vec<PairDofs>,
     phi: Mat<f64>,
     omega2: Vec<f64>,
-    /// `K^-1 Pn^T` (`n x nR`, m/N).
-    zn: Mat<f64>,
-    /// `K^-1 Pt^T` (`n x nR`, m/N).
-    zt: Mat<f64>,
-    /// `K^-1 M K^-1 Pn^T`, `K^-1 M K^-1 Pt^T` (`n x nR`): the second-order residual terms.
-    yn: Mat<f64>,
-    yt: Mat<f64>,
+    /// Cholesky factor of `K`: the static responses `K^-1 (Pn^T | Pt^T) r` of the
+    /// expansion, solved for the modes expanded.
+    factor: Cholesky,
+    /// `M`, for the second-order residual terms `K^-1 M K^-1 (.)`.
+    m: SparseMat,
     /// Full static `Pn K^-1 Pn^T` (`nR x nR`, m/N).
     wfull: Mat<f64>,
     /// Residual `Pn G Pn^T` (`nR x nR`, m/N).
@@ -132,6 +132,13 @@ impl FreeInterface {
                 got: modes.vectors.nrows(),
             });
         }
+        if m.nrows() != n || m.ncols() != n {
+            return Err(Error::Dimension {
+                context: "free-interface synthesis: M against K".into(),
+                expected: n,
+                got: m.nrows(),
+            });
+        }
         if nm == 0 {
             return Err(Error::Invalid(
                 "free-interface synthesis: no free-interface mode below the cutoff".into(),
@@ -151,33 +158,6 @@ impl FreeInterface {
             }
         }
         let factor = Cholesky::new(k, "K (free-interface synthesis)")?;
-        let mut zn = Mat::<f64>::zeros(n, nr);
-        let mut zt = Mat::<f64>::zeros(n, nr);
-        for (j, p) in pairs.iter().enumerate() {
-            zn[(p.pin[2], j)] += 1.0;
-            zn[(p.disc[2], j)] -= 1.0;
-            for a in 0..2 {
-                zt[(p.pin[a], j)] += p.direction[a];
-                zt[(p.disc[a], j)] -= p.direction[a];
-            }
-        }
-        // K^-1 in place on the columns of `x`, in blocks
-        let solve_blocks = |x: &mut Mat<f64>| {
-            const BLOCK: usize = 64;
-            let mut c0 = 0;
-            while c0 < nr {
-                let b = BLOCK.min(nr - c0);
-                factor.solve_in_place(x.as_mut().subcols_mut(c0, b));
-                c0 += b;
-            }
-        };
-        solve_blocks(&mut zn);
-        solve_blocks(&mut zt);
-        // second-order residual terms K^-1 M K^-1 (Pn^T | Pt^T)
-        let mut yn = crate::reduction::sparse_times(m, zn.as_ref());
-        let mut yt = crate::reduction::sparse_times(m, zt.as_ref());
-        solve_blocks(&mut yn);
-        solve_blocks(&mut yt);
         let pn_rows = |x: MatRef<'_, f64>| {
             Mat::from_fn(nr, x.ncols(), |i, c| {
                 x[(pairs[i].pin[2], c)] - x[(pairs[i].disc[2], c)]
@@ -194,9 +174,34 @@ impl FreeInterface {
         let phi = modes.vectors.clone();
         let pn_phi = pn_rows(phi.as_ref());
         let pt_phi = pt_rows(phi.as_ref());
-        let wfull = pn_rows(zn.as_ref());
+        // Pn K^-1 Pn^T and Pn K^-1 Pt^T, a block of pairs at a time
+        let mut wfull = Mat::<f64>::zeros(nr, nr);
+        let mut wt = Mat::<f64>::zeros(nr, nr);
+        const BLOCK: usize = 64;
+        let mut c0 = 0;
+        while c0 < nr {
+            let b = BLOCK.min(nr - c0);
+            let mut x = Mat::<f64>::zeros(n, 2 * b);
+            for (j, p) in pairs[c0..c0 + b].iter().enumerate() {
+                x[(p.pin[2], j)] += 1.0;
+                x[(p.disc[2], j)] -= 1.0;
+                for a in 0..2 {
+                    x[(p.pin[a], b + j)] += p.direction[a];
+                    x[(p.disc[a], b + j)] -= p.direction[a];
+                }
+            }
+            factor.solve_in_place(x.as_mut());
+            let rows = pn_rows(x.as_ref());
+            wfull
+                .as_mut()
+                .subcols_mut(c0, b)
+                .copy_from(rows.as_ref().subcols(0, b));
+            wt.as_mut()
+                .subcols_mut(c0, b)
+                .copy_from(rows.as_ref().subcols(b, b));
+            c0 += b;
+        }
         let mut wn = wfull.clone();
-        let mut wt = pn_rows(zt.as_ref());
         // residual flexibility: subtract Pn Phi Omega^-2 (Pn Phi | Pt Phi)^T
         let scaled = Mat::from_fn(nr, nm, |i, c| pn_phi[(i, c)] / modes.omega2[c]);
         matmul(
@@ -221,10 +226,20 @@ impl FreeInterface {
             pairs: pairs.to_vec(),
             phi,
             omega2: modes.omega2.clone(),
-            zn,
-            zt,
-            yn,
-            yt,
+            factor,
+            m: {
+                let sym = m.symbolic();
+                SparseMat::new(
+                    faer::sparse::SymbolicSparseColMat::new_checked(
+                        n,
+                        n,
+                        sym.col_ptr().to_vec(),
+                        None,
+                        sym.row_idx().to_vec(),
+                    ),
+                    m.val().to_vec(),
+                )
+            },
             wfull,
             wn,
             wt,
@@ -404,39 +419,46 @@ impl FreeInterface {
                 coef[(j, k + c)] = e.im;
             }
         }
-        let (yn, yt) = if second {
-            (&self.yn, &self.yt)
-        } else {
-            (&self.zn, &self.zt)
-        };
-        let mut u = Mat::<f64>::zeros(self.dofs(), 2 * k);
+        // K^-1 B^T r, or K^-1 M K^-1 B^T r
+        let mut u = self.static_response(rfull.as_ref(), mu);
+        if second {
+            u = crate::reduction::sparse_times(self.m.as_ref(), u.as_ref());
+            self.factor.solve_in_place(u.as_mut());
+        }
         matmul(
             u.as_mut(),
-            Accum::Replace,
+            Accum::Add,
             self.phi.as_ref(),
             coef.as_ref(),
             1.0,
             par(),
         );
-        matmul(
-            u.as_mut(),
-            Accum::Add,
-            yn.as_ref(),
-            rfull.as_ref(),
-            1.0,
-            par(),
-        );
-        if mu != 0.0 {
-            matmul(
-                u.as_mut(),
-                Accum::Add,
-                yt.as_ref(),
-                rfull.as_ref(),
-                mu,
-                par(),
-            );
-        }
         u
+    }
+
+    /// `K^-1 (Pn^T + mu Pt^T) r` for the pair loads `r` (`nR x c`, N): `n x c` (m).
+    fn static_response(&self, r: MatRef<'_, f64>, mu: f64) -> Mat<f64> {
+        let mut x = Mat::<f64>::zeros(self.dofs(), r.ncols());
+        for (i, p) in self.pairs.iter().enumerate() {
+            for c in 0..r.ncols() {
+                let v = r[(i, c)];
+                if v == 0.0 {
+                    continue;
+                }
+                x[(p.pin[2], c)] += v;
+                x[(p.disc[2], c)] -= v;
+                if mu != 0.0 {
+                    for a in 0..2 {
+                        x[(p.pin[a], c)] += mu * p.direction[a] * v;
+                        x[(p.disc[a], c)] -= mu * p.direction[a] * v;
+                    }
+                }
+            }
+        }
+        if r.ncols() > 0 {
+            self.factor.solve_in_place(x.as_mut());
+        }
+        x
     }
 
     /// The second-order residual directions of the synthesized modes `which`:
@@ -472,14 +494,8 @@ impl FreeInterface {
                     cf[(i, c)] = cfix[(row, c)];
                 }
             }
-            matmul(
-                w.as_mut(),
-                Accum::Add,
-                self.zn.as_ref(),
-                cf.as_ref(),
-                -1.0,
-                par(),
-            );
+            let fix = self.static_response(cf.as_ref(), 0.0);
+            w -= &fix;
         }
         Ok(Mat::from_fn(n, k, |i, c| {
             c64::new(w[(i, c)], w[(i, k + c)])

@@ -125,6 +125,14 @@ pub fn face_ties(
     for &m in masters {
         let p = mesh.nodes[m];
         if let (Some(i), Some(j)) = (line(xs, p[0]), line(ys, p[1])) {
+            if at[j * nx + i] != usize::MAX && at[j * nx + i] != m {
+                return Err(format!(
+                    "two master nodes ({} and {m}) at grid point ({:e}, {:e}) m",
+                    at[j * nx + i],
+                    p[0],
+                    p[1]
+                ));
+            }
             at[j * nx + i] = m;
         }
     }

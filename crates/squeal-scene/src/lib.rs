@@ -10,8 +10,8 @@ mod spec;
 
 pub use model::{build, element_size, BodyKind, BodyStats, ContactGrid, Model, SizeRule};
 pub use spec::{
-    ContactSpec, Damping, Disc, Flange, Hat, ImportedMesh, Load, MaterialSpec, MeshImport,
-    MeshRule, Pin, Plate, Scene, Study, Zone, BUILTIN_SCENES,
+    ContactRefinement, ContactSpec, Damping, Disc, Flange, Hat, ImportedMesh, Load, MaterialSpec,
+    MeshImport, MeshRule, Pin, Plate, Scene, Study, Zone, BUILTIN_SCENES,
 };
 
 use thiserror::Error;

@@ -478,6 +478,29 @@ impl Patch {
         }
     }
 
+    /// The patch with lines every `r.element_m` or less inside `r.region_m` (face
+    /// coordinates), widened outward to this patch's lines; this patch's lines elsewhere.
+    fn refined(&self, r: &crate::ContactRefinement) -> Patch {
+        let lines = |v: &[f64], lo: f64, hi: f64| {
+            let tol = 1e-9 * (v[v.len() - 1] - v[0]);
+            let a = v.iter().rposition(|&x| x <= lo + tol).unwrap_or(0);
+            let b = v.iter().position(|&x| x >= hi - tol).unwrap_or(v.len() - 1);
+            let n = ((v[b] - v[a]) / r.element_m - 1e-9).ceil().max(1.0) as usize;
+            let mut out = v[..a].to_vec();
+            out.extend(squeal_fe::mesh::linspace(v[a], v[b], n));
+            out.extend_from_slice(&v[b + 1..]);
+            out
+        };
+        let [x0, y0, a, b] = r.region_m;
+        let (cx, cy) = (self.xs[0], self.ys[0]);
+        let mut p = Patch::from_grid(
+            lines(&self.xs, cx + x0, cx + x0 + a),
+            lines(&self.ys, cy + y0, cy + y0 + b),
+        );
+        p.yc = self.yc;
+        p
+    }
+
     /// Half the angle the patch spans at its centre radius.
     fn half_angle(&self) -> f64 {
         self.xs[self.xs.len() - 1] / self.yc
@@ -650,6 +673,21 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
         (Some(p), _) => Some(Patch::new(p, rule.pin_face_elements)),
         (None, _) => None,
     };
+    // Contact refinement: the fine contact grid, carried by tied contact layers; the disc
+    // layer (element_m thick) lifts the pin assembly by `lift`.
+    let fine = match (&rule.contact_refinement, &patch) {
+        (Some(r), Some(pa)) if pin_import.is_none() && disc_import.is_none() => {
+            Some((pa.refined(r), r.element_m))
+        }
+        _ => None,
+    };
+    let lift = fine.as_ref().map_or(0.0, |f| f.1);
+    let mut ties: Vec<squeal_fe::Tie> = Vec::new();
+    let tie_error = |m: String| SceneError::Field {
+        file: file.into(),
+        field: "mesh.contact_refinement".into(),
+        message: m,
+    };
 
     let disc_built = which == BodyKind::Disc || (which == BodyKind::All && scene.disc.is_some());
     if let (true, Some((imp, im))) = (disc_built, &disc_import) {
@@ -790,6 +828,28 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
         let nt = thetas.len();
         let ring = Mesh::annulus_mapped(&rs, &thetas, &zs, &xy_map).with_body(body);
         let map = mesh.append(&ring, "disc.", None);
+        if let (Some((fp, t)), Some(pa)) = (&fine, &patch) {
+            // the disc's contact layer on the ring's top under the pin face, its bottom
+            // tied to the ring's patch grid
+            let layer = Mesh::block(&fp.xs, &fp.ys, &[0.0, *t]).with_body(body);
+            mesh.append(&layer, "disc_layer.", None);
+            ties.extend(
+                squeal_fe::mesh::face_ties(
+                    &mesh,
+                    mesh.node_set("disc_layer.zmin").map_err(tie_error)?,
+                    mesh.node_set("disc.zmax").map_err(tie_error)?,
+                    &pa.xs,
+                    &pa.ys,
+                )
+                .map_err(|m| tie_error(format!("disc contact layer: {m}")))?,
+            );
+            sizes.push(SizeRule {
+                body: "disc contact layer".into(),
+                wavelength_m: f64::NAN,
+                element_size_m: fp.step,
+                divisions: [fp.xs.len() - 1, fp.ys.len() - 1, 1],
+            });
+        }
         let mut divisions = [rs.len() - 1, nt, zs.len() - 1];
         let mut hat_rule = None;
         match (&d.hat, wall) {
@@ -963,17 +1023,63 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             zp.push(z);
         }
         let nzp = zp.len() - 1;
-        let pin = Mesh::block(&pa.xs, &pa.ys, &zp).with_body(materials.len());
-        mesh.append(&pin, "pin.", None);
+        match &fine {
+            None => {
+                let pin = Mesh::block(&pa.xs, &pa.ys, &zp).with_body(materials.len());
+                mesh.append(&pin, "pin.", None);
+            }
+            Some((fp, t)) => {
+                // the pin's first layer becomes the fine contact layer, its top tied to
+                // the coarse pin above it; everything sits `lift` higher
+                if zp.len() < 3 {
+                    return Err(tie_error(format!(
+                        "the pin ({} m high) has a single element layer; the contact layer \
+                         needs a second one (raise mesh.min_layers)",
+                        p.height_m
+                    )));
+                }
+                let up: Vec<f64> = zp[1..].iter().map(|z| z + lift).collect();
+                let pin = Mesh::block(&pa.xs, &pa.ys, &up).with_body(materials.len());
+                mesh.append(&pin, "pin.", None);
+                let nl = (zp[1] / (2.0 * t) - 1e-9).ceil().max(1.0) as usize;
+                let layer = Mesh::block(
+                    &fp.xs,
+                    &fp.ys,
+                    &squeal_fe::mesh::linspace(lift, lift + zp[1], nl),
+                )
+                .with_body(materials.len());
+                mesh.append(&layer, "pin_layer.", None);
+                ties.extend(
+                    squeal_fe::mesh::face_ties(
+                        &mesh,
+                        mesh.node_set("pin_layer.zmax").map_err(tie_error)?,
+                        mesh.node_set("pin.zmin").map_err(tie_error)?,
+                        &pa.xs,
+                        &pa.ys,
+                    )
+                    .map_err(|m| tie_error(format!("pin contact layer: {m}")))?,
+                );
+                sizes.push(SizeRule {
+                    body: "pin contact layer".into(),
+                    wavelength_m: f64::NAN,
+                    element_size_m: fp.step,
+                    divisions: [fp.xs.len() - 1, fp.ys.len() - 1, nl],
+                });
+            }
+        }
         sizes.push(SizeRule {
             body: "pin".into(),
             wavelength_m: f64::NAN,
             element_size_m: h_pin,
-            divisions: [rule.pin_face_elements, rule.pin_face_elements, nzp],
+            divisions: [
+                rule.pin_face_elements,
+                rule.pin_face_elements,
+                nzp - usize::from(fine.is_some()),
+            ],
         });
         materials.push(pin_mat);
         body_names.push("pin".into());
-        let mut z = p.height_m;
+        let mut z = p.height_m + lift;
         for ((name, pl), (m, lambda, h)) in plates.iter().zip(plate_mats) {
             let nz = ((pl.thickness_m / h).ceil() as usize).max(rule.min_layers);
             let xs_p = within(&xs, -pl.length_x_m / 2.0, pl.length_x_m / 2.0);
@@ -1023,13 +1129,21 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
                     format!("the generated {body}"),
                 ),
             };
-            let pin_face = face("pin", &pin_import, "zmin");
-            let disc_face = face("disc", &disc_import, "zmax");
+            let (pin_face, disc_face) = match &fine {
+                None => (
+                    face("pin", &pin_import, "zmin"),
+                    face("disc", &disc_import, "zmax"),
+                ),
+                Some(_) => (
+                    ("pin_layer.zmin".to_string(), String::new()),
+                    ("disc_layer.zmax".to_string(), String::new()),
+                ),
+            };
             let named = (pin_import.is_some() || disc_import.is_some())
                 .then(|| format!(" (pin face: {}; disc face: {})", pin_face.1, disc_face.1));
             Some(contact_grid(
                 &mesh,
-                pa,
+                fine.as_ref().map_or(pa, |f| &f.0),
                 [&pin_face.0, &disc_face.0],
                 named.as_deref().unwrap_or(""),
                 file,
@@ -1039,7 +1153,8 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
     };
     fixed_nodes.sort_unstable();
     fixed_nodes.dedup();
-    let dofs = DofMap::new(&mesh, &DofMap::node_dofs(&fixed_nodes));
+    let dofs =
+        DofMap::with_ties(&mesh, &DofMap::node_dofs(&fixed_nodes), &ties).map_err(tie_error)?;
     let refs: Vec<&dyn Material> = materials.iter().map(|m| m.as_ref()).collect();
     let asm = assemble(&mesh, &dofs, &refs).map_err(|source| SceneError::Core {
         file: file.into(),

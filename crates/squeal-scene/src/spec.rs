@@ -302,6 +302,26 @@ pub struct MeshRule {
     pub pin_face_elements: usize,
     /// Growth ratio of consecutive element sizes away from the refined contact patch.
     pub grading_ratio: f64,
+    /// A finer contact grid over part of the pin face, for mesoscopic contact studies:
+    /// thin contact layers tied to the coarse bodies (see [`ContactRefinement`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_refinement: Option<ContactRefinement>,
+}
+
+/// Contact refinement: the contact grid gets lines every `element_m` or less inside
+/// `region_m` (widened to the coarse grid lines around it), the coarse lines elsewhere.
+/// The fine grid lives in two contact layers tied to the coarse bodies: on the pin, a
+/// layer one coarse step thick (pad material, in place of the pin's first coarse layer);
+/// on the disc, a layer `element_m` thick under the pin face (disc material, added on the
+/// disc's surface; the pin assembly sits that much higher).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactRefinement {
+    /// `[x0, y0, a, b]` (m): the refined rectangle, from the pin face's (-x, -y) corner
+    /// (as contact zones), `a` along the sliding direction x, `b` radial.
+    pub region_m: [f64; 4],
+    /// Largest contact element side inside the region (m).
+    pub element_m: f64,
 }
 
 impl Default for MeshRule {
@@ -313,6 +333,7 @@ impl Default for MeshRule {
             min_layers: 4,
             pin_face_elements: 20,
             grading_ratio: 1.25,
+            contact_refinement: None,
         }
     }
 }
@@ -937,6 +958,50 @@ impl Scene {
                 "expected at least 1 layer and 1 pin face element".into(),
             ));
         }
+        if let Some(r) = &m.contact_refinement {
+            let Some(p) = &self.pin else {
+                return Err(field(
+                    "mesh.contact_refinement",
+                    "refines the pin face's contact grid: a [pin] table is required".into(),
+                ));
+            };
+            if p.mesh.is_some() || self.disc.as_ref().is_some_and(|d| d.mesh.is_some()) {
+                return Err(field(
+                    "mesh.contact_refinement",
+                    "only generated meshes are refined; an imported mesh brings its own grid"
+                        .into(),
+                ));
+            }
+            let step = p.size_x_m.min(p.size_y_m) / m.pin_face_elements as f64;
+            if !(r.element_m.is_finite() && r.element_m > 0.0 && r.element_m < step) {
+                return Err(field(
+                    "mesh.contact_refinement.element_m",
+                    format!(
+                        "expected an element side in (0, {step:e}) m (below the coarse contact \
+                         grid step), got {}",
+                        r.element_m
+                    ),
+                ));
+            }
+            let [x0, y0, a, b] = r.region_m;
+            let fits = |lo: f64, len: f64, size: f64| {
+                lo.is_finite()
+                    && len.is_finite()
+                    && lo >= 0.0
+                    && len > 0.0
+                    && lo + len <= size * (1.0 + 1e-9)
+            };
+            if !(fits(x0, a, p.size_x_m) && fits(y0, b, p.size_y_m)) {
+                return Err(field(
+                    "mesh.contact_refinement.region_m",
+                    format!(
+                        "expected [x0, y0, a, b] (m) with a, b > 0 inside the {} x {} m pin \
+                         face, got {:?}",
+                        p.size_x_m, p.size_y_m, r.region_m
+                    ),
+                ));
+            }
+        }
         if !(m.grading_ratio.is_finite() && (1.0..=3.0).contains(&m.grading_ratio)) {
             return Err(field(
                 "mesh.grading_ratio",
@@ -1068,6 +1133,14 @@ impl Scene {
                         ))
                     }
                 }
+            }
+            (Zone::Mask { .. }, Some(_)) if m.contact_refinement.is_some() => {
+                return Err(field(
+                    "contact.zone",
+                    "a mask zone lists the uniform grid's pairs; it cannot be combined with \
+                     mesh.contact_refinement (use a rectangle or plateaus zone)"
+                        .into(),
+                ))
             }
             (Zone::Mask { values, file }, Some(_)) => {
                 let want = (m.pin_face_elements + 1) * (m.pin_face_elements + 1);

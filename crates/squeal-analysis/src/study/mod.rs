@@ -405,6 +405,28 @@ impl GridInfo {
         })
     }
 
+    /// Largest grid spacing along x and y between the grid lines inside the rectangle
+    /// `[x0, y0, a, b]` (m from the face corner): the resolution a refined contact grid
+    /// has there.
+    pub fn spacing_in(&self, region_m: [f64; 4]) -> [f64; 2] {
+        let [x0, y0, a, b] = region_m;
+        let tol = 1e-9 * self.face_m[0].max(self.face_m[1]);
+        let xs: Vec<f64> = self.points_m[..self.n[0]].iter().map(|p| p[0]).collect();
+        let ys: Vec<f64> = (0..self.n[1])
+            .map(|j| self.points_m[j * self.n[0]][1])
+            .collect();
+        let step = |v: &[f64], lo: f64, hi: f64| {
+            // the lines inside, and the nearest line beyond each end
+            let i0 = v.iter().rposition(|&x| x <= lo + tol).unwrap_or(0);
+            let i1 = v.iter().position(|&x| x >= hi - tol).unwrap_or(v.len() - 1);
+            v[i0..=i1]
+                .windows(2)
+                .map(|w| w[1] - w[0])
+                .fold(0.0, f64::max)
+        };
+        [step(&xs, x0, x0 + a), step(&ys, y0, y0 + b)]
+    }
+
     /// Pairs of the grid inside `zone`.
     pub fn pairs_in(&self, zone: &Zone) -> usize {
         zone.select(&self.points_m, self.face_m)
@@ -692,22 +714,28 @@ impl StudyDef {
                         ),
                     ));
                 }
-                let sp = self.grid.spacing_m[0].max(self.grid.spacing_m[1]);
+                let sp_in = self.grid.spacing_in(s.region_m);
+                let sp = sp_in[0].max(sp_in[1]);
                 if let Some(p) = s.patch_m.iter().find(|p| **p < sp * (1.0 - 1e-9)) {
-                    let need = (self.grid.face_m[0].max(self.grid.face_m[1]) / p).ceil();
                     return Err(input(
                         "--patch",
                         format!(
                             "patch side {:.3} mm is smaller than the contact grid spacing \
-                             {:.3} mm of the scene ({} x {} pairs): expected patch sides >= \
-                             {:.3} mm, or a scene with a finer contact grid \
-                             (mesh.pin_face_elements >= {need}; the paper used 0.2 mm contact \
-                             elements)",
+                             {:.3} mm of the scene in the region ({} x {} pairs on the face): \
+                             expected patch sides >= {:.3} mm, or a scene with a finer contact \
+                             grid there (mesh.contact_refinement = {{ region_m = [{}, {}, {}, \
+                             {}], element_m = {} }}, or a larger mesh.pin_face_elements; the \
+                             paper used 0.2 mm contact elements)",
                             p * 1e3,
                             sp * 1e3,
                             self.grid.n[0],
                             self.grid.n[1],
-                            sp * 1e3
+                            sp * 1e3,
+                            x0,
+                            y0,
+                            a,
+                            b,
+                            p / 2.0
                         ),
                     ));
                 }
