@@ -328,7 +328,8 @@ enum SweepKind {
     /// square patches, seeded random subsets of them in contact (all their pairs closed
     /// and sliding), --layouts per patch size. Defaults: the paper's patch sizes and mu
     /// for --coupling 2 (2100 Hz) or 1 (3500 Hz); those patches need a contact grid of
-    /// 0.2 mm (mesh.pin_face_elements = 100): on the default scene (1 mm) give --patch.
+    /// 0.2 mm / 0.5 mm in the region (mesh.contact_refinement; scenes/pin-on-disc-meso.toml
+    /// and scenes/pin-on-disc-meso-c1.toml): on the default scene (1 mm) give --patch.
     /// Same outputs, resume and shards as `sweep macro`.
     Meso {
         /// Scene file (TOML) or embedded scene name; default: `pin-on-disc`.

@@ -81,14 +81,22 @@ pub fn info(registry: &Registry, scene: &Scene, file: &str) -> Result<()> {
     }
     println!("\ndamping: {}", scene.damping.describe());
     match &model.contact {
-        Some(c) => println!(
-            "\ncontact: {} node-to-node pairs ({} x {} grid, step {:.3} mm), max (x, y) mismatch {:.1e} m",
-            c.len(),
-            c.xs.len(),
-            c.ys.len(),
-            (c.xs[1] - c.xs[0]) * 1e3,
-            c.max_mismatch_m
-        ),
+        Some(c) => {
+            let steps = c.xs.windows(2).chain(c.ys.windows(2)).map(|w| w[1] - w[0]);
+            let (lo, hi) = steps.fold((f64::INFINITY, 0.0f64), |(l, h), d| (l.min(d), h.max(d)));
+            let step = if hi - lo <= 1e-9 * hi {
+                format!("step {:.3} mm", hi * 1e3)
+            } else {
+                format!("steps {:.3}-{:.3} mm", lo * 1e3, hi * 1e3)
+            };
+            println!(
+                "\ncontact: {} node-to-node pairs ({} x {} grid, {step}), max (x, y) mismatch {:.1e} m",
+                c.len(),
+                c.xs.len(),
+                c.ys.len(),
+                c.max_mismatch_m
+            )
+        }
         None => println!("\ncontact: none (the scene needs a disc and a pin)"),
     }
     Ok(())

@@ -15,10 +15,12 @@
 //! `Q = B_A Phi`, whatever the number of pairs. The residual contact flexibilities
 //! `Pn G Pn^T`, `Pn G Pt^T` of the candidate pairs are computed once (one Cholesky
 //! factorization of `K`, kept, and `2 nR` solves whose pair rows alone are kept, so the
-//! memory is `O(nR^2)`, not `O(n nR)`): a new contact set or mu then costs one
-//! `nA x nA` LU, one `m x m` eigen decomposition and the expansion
-//! `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r` (one block solve for the modes
-//! expanded), which satisfies `Pn_A u = 0` exactly.
+//! memory is `O(nR^2)`, not `O(n nR)`; the whole responses `K^-1 (Pn^T | Pt^T)` and their
+//! second-order terms are stored too when they fit [`STORE_LIMIT_BYTES`]): a new contact
+//! set or mu then costs one `nA x nA` LU, one `m x m` eigen decomposition and the
+//! expansion `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r` (products with the stored
+//! responses, or block solves for the modes expanded), which satisfies `Pn_A u = 0`
+//! exactly.
 //!
 //! The residual flexibility is static (its inertia is neglected), so the synthesized modes
 //! are approximations whose error falls with the ratio of the band to the modal cutoff;
@@ -53,8 +55,11 @@ pub struct FreeInterface {
     phi: Mat<f64>,
     omega2: Vec<f64>,
     /// Cholesky factor of `K`: the static responses `K^-1 (Pn^T | Pt^T) r` of the
-    /// expansion, solved for the modes expanded.
+    /// expansion, solved for the modes expanded (when they are not stored).
     factor: Cholesky,
+    /// The static responses of every candidate pair, stored when they fit the memory
+    /// limit: faster expansions, `4 n nR` values.
+    stored: Option<Stored>,
     /// `M`, for the second-order residual terms `K^-1 M K^-1 (.)`.
     m: SparseMat,
     /// Full static `Pn K^-1 Pn^T` (`nR x nR`, m/N).
@@ -71,6 +76,18 @@ pub struct FreeInterface {
     /// Wall time of the construction, modes excluded (s).
     pub time_s: f64,
 }
+
+/// `K^-1 Pn^T`, `K^-1 Pt^T` and the second-order terms `K^-1 M K^-1 (Pn^T | Pt^T)`
+/// (`n x nR` each).
+struct Stored {
+    zn: Mat<f64>,
+    zt: Mat<f64>,
+    yn: Mat<f64>,
+    yt: Mat<f64>,
+}
+
+/// Largest memory (bytes) [`FreeInterface::new`] spends on stored static responses.
+pub const STORE_LIMIT_BYTES: usize = 3 << 30;
 
 /// The synthesized modes of one contact set at one mu.
 #[derive(Debug, Clone)]
@@ -109,12 +126,26 @@ impl FreeInterface {
     /// Builds the free-interface data of the model `(k, m)` (free DOFs, `K` positive
     /// definite) for the candidate `pairs`, with the free-interface `modes` (of the same
     /// `(K, M)`, `M`-orthonormal, e.g. from an [`EigenSolver`](crate::EigenSolver) up to a
-    /// cutoff above the band).
+    /// cutoff above the band). The static responses of the pairs are stored when they fit
+    /// in [`STORE_LIMIT_BYTES`], otherwise solved for each expansion.
     pub fn new(
         k: SparseRef<'_>,
         m: SparseRef<'_>,
         pairs: &[PairDofs],
         modes: &RealModes,
+    ) -> Result<Self> {
+        Self::with_store_limit(k, m, pairs, modes, STORE_LIMIT_BYTES)
+    }
+
+    /// [`FreeInterface::new`] with the memory limit (bytes) of the stored static
+    /// responses (`32 n nR` bytes); 0 never stores them. Both ways give the same modes to
+    /// round-off.
+    pub fn with_store_limit(
+        k: SparseRef<'_>,
+        m: SparseRef<'_>,
+        pairs: &[PairDofs],
+        modes: &RealModes,
+        store_limit_bytes: usize,
     ) -> Result<Self> {
         let start = Instant::now();
         let n = k.nrows();
@@ -174,10 +205,18 @@ impl FreeInterface {
         let phi = modes.vectors.clone();
         let pn_phi = pn_rows(phi.as_ref());
         let pt_phi = pt_rows(phi.as_ref());
-        // Pn K^-1 Pn^T and Pn K^-1 Pt^T, a block of pairs at a time
+        // Pn K^-1 Pn^T and Pn K^-1 Pt^T, a block of pairs at a time; the whole responses
+        // kept when they fit
         let mut wfull = Mat::<f64>::zeros(nr, nr);
         let mut wt = Mat::<f64>::zeros(nr, nr);
         const BLOCK: usize = 64;
+        let store = 32usize.saturating_mul(n).saturating_mul(nr) <= store_limit_bytes;
+        let mut stored = store.then(|| Stored {
+            zn: Mat::zeros(n, nr),
+            zt: Mat::zeros(n, nr),
+            yn: Mat::zeros(0, 0),
+            yt: Mat::zeros(0, 0),
+        });
         let mut c0 = 0;
         while c0 < nr {
             let b = BLOCK.min(nr - c0);
@@ -191,6 +230,16 @@ impl FreeInterface {
                 }
             }
             factor.solve_in_place(x.as_mut());
+            if let Some(st) = stored.as_mut() {
+                st.zn
+                    .as_mut()
+                    .subcols_mut(c0, b)
+                    .copy_from(x.as_ref().subcols(0, b));
+                st.zt
+                    .as_mut()
+                    .subcols_mut(c0, b)
+                    .copy_from(x.as_ref().subcols(b, b));
+            }
             let rows = pn_rows(x.as_ref());
             wfull
                 .as_mut()
@@ -200,6 +249,18 @@ impl FreeInterface {
                 .subcols_mut(c0, b)
                 .copy_from(rows.as_ref().subcols(b, b));
             c0 += b;
+        }
+        if let Some(st) = stored.as_mut() {
+            // second-order residual terms K^-1 M K^-1 (Pn^T | Pt^T)
+            for (z, y) in [(&st.zn, &mut st.yn), (&st.zt, &mut st.yt)] {
+                *y = crate::reduction::sparse_times(m, z.as_ref());
+                let mut c0 = 0;
+                while c0 < nr {
+                    let b = BLOCK.min(nr - c0);
+                    factor.solve_in_place(y.as_mut().subcols_mut(c0, b));
+                    c0 += b;
+                }
+            }
         }
         let mut wn = wfull.clone();
         // residual flexibility: subtract Pn Phi Omega^-2 (Pn Phi | Pt Phi)^T
@@ -227,6 +288,7 @@ impl FreeInterface {
             phi,
             omega2: modes.omega2.clone(),
             factor,
+            stored,
             m: {
                 let sym = m.symbolic();
                 SparseMat::new(
@@ -248,6 +310,11 @@ impl FreeInterface {
             cutoff_hz,
             time_s: start.elapsed().as_secs_f64(),
         })
+    }
+
+    /// Whether the static responses of the pairs are stored (else solved per expansion).
+    pub fn stores_responses(&self) -> bool {
+        self.stored.is_some()
     }
 
     /// Number of candidate pairs.
@@ -420,11 +487,43 @@ impl FreeInterface {
             }
         }
         // K^-1 B^T r, or K^-1 M K^-1 B^T r
-        let mut u = self.static_response(rfull.as_ref(), mu);
-        if second {
-            u = crate::reduction::sparse_times(self.m.as_ref(), u.as_ref());
-            self.factor.solve_in_place(u.as_mut());
-        }
+        let mut u = match &self.stored {
+            Some(st) => {
+                let (yn, yt) = if second {
+                    (&st.yn, &st.yt)
+                } else {
+                    (&st.zn, &st.zt)
+                };
+                let mut u = Mat::<f64>::zeros(self.dofs(), 2 * k);
+                matmul(
+                    u.as_mut(),
+                    Accum::Replace,
+                    yn.as_ref(),
+                    rfull.as_ref(),
+                    1.0,
+                    par(),
+                );
+                if mu != 0.0 {
+                    matmul(
+                        u.as_mut(),
+                        Accum::Add,
+                        yt.as_ref(),
+                        rfull.as_ref(),
+                        mu,
+                        par(),
+                    );
+                }
+                u
+            }
+            None => {
+                let mut u = self.static_response(rfull.as_ref(), mu);
+                if second {
+                    u = crate::reduction::sparse_times(self.m.as_ref(), u.as_ref());
+                    self.factor.solve_in_place(u.as_mut());
+                }
+                u
+            }
+        };
         matmul(
             u.as_mut(),
             Accum::Add,
@@ -494,8 +593,17 @@ impl FreeInterface {
                     cf[(i, c)] = cfix[(row, c)];
                 }
             }
-            let fix = self.static_response(cf.as_ref(), 0.0);
-            w -= &fix;
+            match &self.stored {
+                Some(st) => matmul(
+                    w.as_mut(),
+                    Accum::Add,
+                    st.zn.as_ref(),
+                    cf.as_ref(),
+                    -1.0,
+                    par(),
+                ),
+                None => w -= &self.static_response(cf.as_ref(), 0.0),
+            }
         }
         Ok(Mat::from_fn(n, k, |i, c| {
             c64::new(w[(i, c)], w[(i, k + c)])

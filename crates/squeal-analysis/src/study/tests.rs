@@ -411,3 +411,67 @@ fn summaries_count_classes_per_group() {
     assert!(!s.complete);
     assert_eq!(s.cases_done, 3);
 }
+
+/// A 20 mm face with 1 mm lines and 0.2 mm lines over x in [10, 20] mm, y in [4, 18] mm
+/// (a contact refinement).
+fn refined_grid() -> GridInfo {
+    let lines = |lo: f64, hi: f64| -> Vec<f64> {
+        let mut v: Vec<f64> = (0..=20)
+            .map(|i| i as f64 * 1e-3)
+            .filter(|&x| x < lo - 1e-9 || x > hi + 1e-9)
+            .collect();
+        v.extend((0..=((hi - lo) / 2e-4).round() as usize).map(|i| lo + i as f64 * 2e-4));
+        v.sort_by(f64::total_cmp);
+        v
+    };
+    let (xs, ys) = (lines(0.010, 0.020), lines(0.004, 0.018));
+    let points_m = ys
+        .iter()
+        .flat_map(|&y| xs.iter().map(move |&x| [x, y]))
+        .collect();
+    GridInfo {
+        face_m: [0.02, 0.02],
+        n: [xs.len(), ys.len()],
+        spacing_m: [1e-3, 1e-3],
+        points_m,
+    }
+}
+
+#[test]
+fn meso_patches_follow_the_grid_spacing_inside_their_region() {
+    let g = refined_grid();
+    let fine = g.spacing_in([0.010, 0.004, 0.010, 0.014]);
+    assert!(
+        (fine[0] - 2e-4).abs() < 1e-12 && (fine[1] - 2e-4).abs() < 1e-12,
+        "{fine:?}"
+    );
+    // a region reaching past the fine band sees the coarse step
+    let wide = g.spacing_in([0.009, 0.004, 0.011, 0.014]);
+    assert!((wide[0] - 1e-3).abs() < 1e-12, "{wide:?}");
+    let mut d = def(meso_spec(vec![0.0004, 0.0016]));
+    d.grid = g.clone();
+    if let StudySpec::Meso(s) = &mut d.study {
+        s.region_m = [0.010, 0.004, 0.010, 0.014];
+        s.layouts = 3;
+    }
+    let list = d.cases().expect("0.4 mm patches on the 0.2 mm region");
+    // a 0.4 mm patch holds 3 x 3 pairs (its edges on grid lines), half the patches in
+    // contact: about half the region's 51 x 71 pairs
+    let small: Vec<&Case> = list
+        .cases
+        .iter()
+        .filter(|c| c.patch_m == Some(0.0004))
+        .collect();
+    assert_eq!(small.len(), 3);
+    for c in &small {
+        assert!((1200..=2700).contains(&c.pairs), "{} pairs", c.pairs);
+    }
+    if let StudySpec::Meso(s) = &mut d.study {
+        s.region_m = [0.0, 0.004, 0.010, 0.014];
+    }
+    let e = message(d.cases().unwrap_err());
+    assert!(
+        e.starts_with("--patch: ") && e.contains(">= 1.000 mm") && e.contains("contact_refinement"),
+        "{e}"
+    );
+}

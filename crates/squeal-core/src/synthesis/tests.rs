@@ -216,3 +216,47 @@ fn bad_inputs_are_errors() {
     assert!(fi.synthesize(&[7], 0.3).is_err());
     assert!(fi.synthesize(&[0], f64::NAN).is_err());
 }
+
+#[test]
+fn solved_and_stored_responses_expand_alike() {
+    // the memory-light way (static responses solved per expansion) against the stored one
+    let (k, m) = model();
+    let build = |limit: usize| {
+        FreeInterface::with_store_limit(
+            sparse(&k).as_ref(),
+            mass(&m).as_ref(),
+            &pairs(),
+            &modes(&k, &m, 12),
+            limit,
+        )
+        .unwrap()
+    };
+    let (stored, solved) = (build(usize::MAX), build(0));
+    assert!(stored.stores_responses() && !solved.stores_responses());
+    let active = [0, 2, 3];
+    let (a, b) = (
+        stored.synthesize(&active, 0.6).unwrap(),
+        solved.synthesize(&active, 0.6).unwrap(),
+    );
+    let which: Vec<usize> = (0..a.s.len()).collect();
+    for (x, y) in [
+        (stored.expand(&a, &which), solved.expand(&b, &which)),
+        (
+            stored.correction(&a, &which).unwrap(),
+            solved.correction(&b, &which).unwrap(),
+        ),
+    ] {
+        let scale = (0..N)
+            .flat_map(|i| (0..which.len()).map(move |c| (i, c)))
+            .map(|(i, c)| x[(i, c)].norm())
+            .fold(0.0f64, f64::max);
+        let diff = (0..N)
+            .flat_map(|i| (0..which.len()).map(move |c| (i, c)))
+            .map(|(i, c)| (x[(i, c)] - y[(i, c)]).norm())
+            .fold(0.0f64, f64::max);
+        assert!(
+            scale > 0.0 && diff <= 1e-12 * scale,
+            "differ by {diff:e} of {scale:e}"
+        );
+    }
+}
