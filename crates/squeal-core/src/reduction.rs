@@ -338,8 +338,18 @@ pub fn project(op: &FrictionalOperator, v: MatRef<'_, f64>) -> Result<Frictional
     };
     let friction_loads = match &op.friction_loads {
         Some(u) => {
-            let ud = u.as_ref().to_dense();
-            Some(dense_to_sparse(tmul(v, ud.as_ref()).as_ref())?)
+            // V^T U column by column: U has a few nonzeros per column (never densified:
+            // `n x nA` would be gigabytes for thousands of pairs)
+            let u = u.as_ref();
+            let mut r = Mat::<f64>::zeros(v.ncols(), u.ncols());
+            for j in 0..u.ncols() {
+                for (i, x) in u.row_idx_of_col(j).zip(u.val_of_col(j)) {
+                    for c in 0..v.ncols() {
+                        r[(c, j)] += x * v[(i, c)];
+                    }
+                }
+            }
+            Some(dense_to_sparse(r.as_ref())?)
         }
         None => None,
     };

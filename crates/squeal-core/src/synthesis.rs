@@ -451,16 +451,41 @@ impl FreeInterface {
     /// The unconstrained displacements `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r` of the
     /// synthesized modes `which` (`n x which.len()`).
     pub fn expand(&self, syn: &Synthesized, which: &[usize]) -> Mat<c64> {
-        let u = self.combine(syn, which, false);
-        let k = which.len();
+        let (u, _) = self.combine(syn, which, false, None);
+        self.complex(&u, which.len())
+    }
+
+    /// [`FreeInterface::expand`] and [`FreeInterface::correction`] together: when the
+    /// static responses are solved (not stored), the correction reuses the expansion's
+    /// `K^-1 B_A^T r` (one block solve fewer).
+    pub fn expand_with_correction(
+        &self,
+        syn: &Synthesized,
+        which: &[usize],
+    ) -> Result<(Mat<c64>, Mat<c64>)> {
+        let (u, z) = self.combine(syn, which, false, None);
+        let w = self.correction_from(syn, which, z.as_ref())?;
+        Ok((self.complex(&u, which.len()), w))
+    }
+
+    /// Real and imaginary parts side by side (`n x 2k`) to complex columns (`n x k`).
+    fn complex(&self, u: &Mat<f64>, k: usize) -> Mat<c64> {
         Mat::from_fn(self.dofs(), k, |i, c| c64::new(u[(i, c)], u[(i, k + c)]))
     }
 
     /// `Phi e + (Y_n + mu Y_t) r` for the modes `which`, real and imaginary parts side by
     /// side (`n x 2 which.len()`): with `second = false`, `e = eta - Omega^-2 Q^T r` and
     /// `Y = K^-1 (Pn^T | Pt^T)` (the expansion); with `second = true`, `e = -Omega^-4 Q^T r`
-    /// and `Y = K^-1 M K^-1 (Pn^T | Pt^T)` (the second-order residual term).
-    fn combine(&self, syn: &Synthesized, which: &[usize], second: bool) -> Mat<f64> {
+    /// and `Y = K^-1 M K^-1 (Pn^T | Pt^T)` (the second-order residual term). When the
+    /// responses are solved, the first-order call also returns `K^-1 B^T r` and the
+    /// second-order one takes it back as `reuse`.
+    fn combine(
+        &self,
+        syn: &Synthesized,
+        which: &[usize],
+        second: bool,
+        reuse: Option<&Mat<f64>>,
+    ) -> (Mat<f64>, Option<Mat<f64>>) {
         let nm = self.modes();
         let k = which.len();
         let mu = syn.mu;
@@ -487,6 +512,7 @@ impl FreeInterface {
             }
         }
         // K^-1 B^T r, or K^-1 M K^-1 B^T r
+        let mut first = None;
         let mut u = match &self.stored {
             Some(st) => {
                 let (yn, yt) = if second {
@@ -516,12 +542,18 @@ impl FreeInterface {
                 u
             }
             None => {
-                let mut u = self.static_response(rfull.as_ref(), mu);
+                let z = match reuse {
+                    Some(z) => z.clone(),
+                    None => self.static_response(rfull.as_ref(), mu),
+                };
                 if second {
-                    u = crate::reduction::sparse_times(self.m.as_ref(), u.as_ref());
+                    let mut u = crate::reduction::sparse_times(self.m.as_ref(), z.as_ref());
                     self.factor.solve_in_place(u.as_mut());
+                    u
+                } else {
+                    first = Some(z.clone());
+                    z
                 }
-                u
             }
         };
         matmul(
@@ -532,7 +564,7 @@ impl FreeInterface {
             1.0,
             par(),
         );
-        u
+        (u, first)
     }
 
     /// `K^-1 (Pn^T + mu Pt^T) r` for the pair loads `r` (`nR x c`, N): `n x c` (m).
@@ -567,11 +599,21 @@ impl FreeInterface {
     /// (`n x which.len()`). Added to the expanded modes they let the Ritz step recover most
     /// of the residual inertia.
     pub fn correction(&self, syn: &Synthesized, which: &[usize]) -> Result<Mat<c64>> {
+        self.correction_from(syn, which, None)
+    }
+
+    /// [`FreeInterface::correction`], reusing the expansion's `K^-1 B_A^T r` if given.
+    fn correction_from(
+        &self,
+        syn: &Synthesized,
+        which: &[usize],
+        reuse: Option<&Mat<f64>>,
+    ) -> Result<Mat<c64>> {
         let n = self.dofs();
         let nr = self.pairs();
         let na = syn.active.len();
         let k = which.len();
-        let mut w = self.combine(syn, which, true);
+        let (mut w, _) = self.combine(syn, which, true, reuse);
         if na > 0 {
             // static correction onto the ties: c = W_AA^-1 Pn_A w, w -= K^-1 Pn_A^T c
             let waa = Mat::from_fn(na, na, |i, j| self.wfull[(syn.active[i], syn.active[j])]);

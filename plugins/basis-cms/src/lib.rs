@@ -163,9 +163,10 @@ impl ReductionBasis for CmsBasis {
                 "cms: no synthesized mode below {cutoff:.1} Hz"
             )));
         }
-        let mut u = free.expand(&syn, &which);
+        let mut u;
         if self.second_order {
-            let w = free.correction(&syn, &which)?;
+            let w;
+            (u, w) = free.expand_with_correction(&syn, &which)?;
             let k = u.ncols();
             u = Mat::from_fn(u.nrows(), 2 * k, |i, c| {
                 if c < k {
@@ -174,6 +175,8 @@ impl ReductionBasis for CmsBasis {
                     w[(i, c - k)]
                 }
             });
+        } else {
+            u = free.expand(&syn, &which);
         }
         let t = op.t.as_ref().expect("checked by active_in");
         let nc = op.dim();

@@ -239,12 +239,16 @@ fn solved_and_stored_responses_expand_alike() {
         solved.synthesize(&active, 0.6).unwrap(),
     );
     let which: Vec<usize> = (0..a.s.len()).collect();
+    // the solved way with the shared static response, too
+    let (eb, cb) = solved.expand_with_correction(&b, &which).unwrap();
     for (x, y) in [
         (stored.expand(&a, &which), solved.expand(&b, &which)),
         (
             stored.correction(&a, &which).unwrap(),
             solved.correction(&b, &which).unwrap(),
         ),
+        (stored.expand(&a, &which), eb),
+        (stored.correction(&a, &which).unwrap(), cb),
     ] {
         let scale = (0..N)
             .flat_map(|i| (0..which.len()).map(move |c| (i, c)))
