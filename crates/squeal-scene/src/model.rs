@@ -594,6 +594,38 @@ impl Blend {
     }
 }
 
+/// Appends the contact layer `layer` of `body` (node sets `{body}_layer.*`) and ties its
+/// face `tied` to the face `master` of the coarse body (`{body}.{master}`, on the coarse
+/// patch grid); returns the ties and the layer's size rule (`nl` element layers).
+#[allow(clippy::too_many_arguments)]
+fn contact_layer(
+    mesh: &mut Mesh,
+    layer: &Mesh,
+    body: &str,
+    tied: &str,
+    master: &str,
+    coarse: &Patch,
+    fine: &Patch,
+    nl: usize,
+) -> std::result::Result<(Vec<squeal_fe::Tie>, SizeRule), String> {
+    mesh.append(layer, &format!("{body}_layer."), None);
+    let ties = squeal_fe::mesh::face_ties(
+        mesh,
+        mesh.node_set(&format!("{body}_layer.{tied}"))?,
+        mesh.node_set(&format!("{body}.{master}"))?,
+        &coarse.xs,
+        &coarse.ys,
+    )
+    .map_err(|m| format!("{body} contact layer: {m}"))?;
+    let rule = SizeRule {
+        body: format!("{body} contact layer"),
+        wavelength_m: f64::NAN,
+        element_size_m: fine.step,
+        divisions: [fine.xs.len() - 1, fine.ys.len() - 1, nl],
+    };
+    Ok((ties, rule))
+}
+
 /// Builds the bodies of `scene` selected by `which`, with materials from `registry`;
 /// `file` names the scene in errors.
 pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) -> Result<Model> {
@@ -832,23 +864,10 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             // the disc's contact layer on the ring's top under the pin face, its bottom
             // tied to the ring's patch grid
             let layer = Mesh::block(&fp.xs, &fp.ys, &[0.0, *t]).with_body(body);
-            mesh.append(&layer, "disc_layer.", None);
-            ties.extend(
-                squeal_fe::mesh::face_ties(
-                    &mesh,
-                    mesh.node_set("disc_layer.zmin").map_err(tie_error)?,
-                    mesh.node_set("disc.zmax").map_err(tie_error)?,
-                    &pa.xs,
-                    &pa.ys,
-                )
-                .map_err(|m| tie_error(format!("disc contact layer: {m}")))?,
-            );
-            sizes.push(SizeRule {
-                body: "disc contact layer".into(),
-                wavelength_m: f64::NAN,
-                element_size_m: fp.step,
-                divisions: [fp.xs.len() - 1, fp.ys.len() - 1, 1],
-            });
+            let (t, rule) = contact_layer(&mut mesh, &layer, "disc", "zmin", "zmax", pa, fp, 1)
+                .map_err(tie_error)?;
+            ties.extend(t);
+            sizes.push(rule);
         }
         let mut divisions = [rs.len() - 1, nt, zs.len() - 1];
         let mut hat_rule = None;
@@ -1048,23 +1067,10 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
                     &squeal_fe::mesh::linspace(lift, lift + zp[1], nl),
                 )
                 .with_body(materials.len());
-                mesh.append(&layer, "pin_layer.", None);
-                ties.extend(
-                    squeal_fe::mesh::face_ties(
-                        &mesh,
-                        mesh.node_set("pin_layer.zmax").map_err(tie_error)?,
-                        mesh.node_set("pin.zmin").map_err(tie_error)?,
-                        &pa.xs,
-                        &pa.ys,
-                    )
-                    .map_err(|m| tie_error(format!("pin contact layer: {m}")))?,
-                );
-                sizes.push(SizeRule {
-                    body: "pin contact layer".into(),
-                    wavelength_m: f64::NAN,
-                    element_size_m: fp.step,
-                    divisions: [fp.xs.len() - 1, fp.ys.len() - 1, nl],
-                });
+                let (t, rule) = contact_layer(&mut mesh, &layer, "pin", "zmax", "zmin", pa, fp, nl)
+                    .map_err(tie_error)?;
+                ties.extend(t);
+                sizes.push(rule);
             }
         }
         sizes.push(SizeRule {
