@@ -232,6 +232,18 @@ fn shards_merged_equal_the_whole_run() {
             bytes(&alone, "results.jsonl"),
             bytes(&whole, "results.jsonl")
         );
+        // a merged part resumes into the whole run (one set-up for the remaining cases)
+        let r = run(
+            &f,
+            &def,
+            &alone,
+            RunOptions {
+                resume: true,
+                ..RunOptions::default()
+            },
+        );
+        assert!(r.summary.complete, "{name}: the resumed merge is complete");
+        assert_same(&whole, &alone);
         let merged = tmp(&format!("{name}-merged"));
         let (_, s, _) = merge(&[shards[1].clone(), shards[0].clone()], &merged).unwrap();
         assert!(s.complete);
