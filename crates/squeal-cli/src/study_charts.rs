@@ -343,11 +343,16 @@ fn meso_charts(
                 ),
             )
         }));
+        let title = if supp.is_empty() {
+            format!("Plateau layouts with the largest DvR near {c:.0} Hz (no layout suppresses it)")
+        } else {
+            format!(
+                "Plateau layouts that trigger (left) or suppress (right) the coupling near {c:.0} Hz"
+            )
+        };
         files.extend(contact_map(
             &dir.join(format!("layouts_{c:.0}hz")),
-            &format!(
-                "Plateau layouts that trigger (left) or suppress (right) the coupling near {c:.0} Hz"
-            ),
+            &title,
             "pair in contact",
             &panels,
         )?);
