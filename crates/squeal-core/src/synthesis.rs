@@ -122,6 +122,32 @@ fn par() -> Par {
     faer::get_global_parallelism()
 }
 
+/// Adds to column `c` of `x` the pair loads `Pn^T normal + Pt^T sliding` of pair `p`
+/// (on the pin node, and opposite on the disc node).
+fn add_pair_load(x: &mut Mat<f64>, p: &PairDofs, c: usize, normal: f64, sliding: f64) {
+    x[(p.pin[2], c)] += normal;
+    x[(p.disc[2], c)] -= normal;
+    if sliding != 0.0 {
+        for a in 0..2 {
+            x[(p.pin[a], c)] += sliding * p.direction[a];
+            x[(p.disc[a], c)] -= sliding * p.direction[a];
+        }
+    }
+}
+
+/// `K^-1` in place on the columns of `x`, `BLOCK` at a time (bounded workspace).
+fn solve_blocks(factor: &Cholesky, x: &mut Mat<f64>) {
+    let mut c0 = 0;
+    while c0 < x.ncols() {
+        let b = BLOCK.min(x.ncols() - c0);
+        factor.solve_in_place(x.as_mut().subcols_mut(c0, b));
+        c0 += b;
+    }
+}
+
+/// Columns solved together.
+const BLOCK: usize = 64;
+
 impl FreeInterface {
     /// Builds the free-interface data of the model `(k, m)` (free DOFs, `K` positive
     /// definite) for the candidate `pairs`, with the free-interface `modes` (of the same
@@ -209,7 +235,6 @@ impl FreeInterface {
         // kept when they fit
         let mut wfull = Mat::<f64>::zeros(nr, nr);
         let mut wt = Mat::<f64>::zeros(nr, nr);
-        const BLOCK: usize = 64;
         let store = 32usize.saturating_mul(n).saturating_mul(nr) <= store_limit_bytes;
         let mut stored = store.then(|| Stored {
             zn: Mat::zeros(n, nr),
@@ -220,14 +245,11 @@ impl FreeInterface {
         let mut c0 = 0;
         while c0 < nr {
             let b = BLOCK.min(nr - c0);
+            // unit normal loads in the first b columns, unit sliding loads in the next b
             let mut x = Mat::<f64>::zeros(n, 2 * b);
             for (j, p) in pairs[c0..c0 + b].iter().enumerate() {
-                x[(p.pin[2], j)] += 1.0;
-                x[(p.disc[2], j)] -= 1.0;
-                for a in 0..2 {
-                    x[(p.pin[a], b + j)] += p.direction[a];
-                    x[(p.disc[a], b + j)] -= p.direction[a];
-                }
+                add_pair_load(&mut x, p, j, 1.0, 0.0);
+                add_pair_load(&mut x, p, b + j, 0.0, 1.0);
             }
             factor.solve_in_place(x.as_mut());
             if let Some(st) = stored.as_mut() {
@@ -254,12 +276,7 @@ impl FreeInterface {
             // second-order residual terms K^-1 M K^-1 (Pn^T | Pt^T)
             for (z, y) in [(&st.zn, &mut st.yn), (&st.zt, &mut st.yt)] {
                 *y = crate::reduction::sparse_times(m, z.as_ref());
-                let mut c0 = 0;
-                while c0 < nr {
-                    let b = BLOCK.min(nr - c0);
-                    factor.solve_in_place(y.as_mut().subcols_mut(c0, b));
-                    c0 += b;
-                }
+                solve_blocks(&factor, y);
             }
         }
         let mut wn = wfull.clone();
@@ -289,19 +306,12 @@ impl FreeInterface {
             omega2: modes.omega2.clone(),
             factor,
             stored,
-            m: {
-                let sym = m.symbolic();
-                SparseMat::new(
-                    faer::sparse::SymbolicSparseColMat::new_checked(
-                        n,
-                        n,
-                        sym.col_ptr().to_vec(),
-                        None,
-                        sym.row_idx().to_vec(),
-                    ),
-                    m.val().to_vec(),
-                )
-            },
+            m: SparseMat::new(
+                m.symbolic()
+                    .to_owned()
+                    .map_err(|e| Error::Invalid(format!("copy of M: {e:?}")))?,
+                m.val().to_vec(),
+            ),
             wfull,
             wn,
             wt,
@@ -573,16 +583,8 @@ impl FreeInterface {
         for (i, p) in self.pairs.iter().enumerate() {
             for c in 0..r.ncols() {
                 let v = r[(i, c)];
-                if v == 0.0 {
-                    continue;
-                }
-                x[(p.pin[2], c)] += v;
-                x[(p.disc[2], c)] -= v;
-                if mu != 0.0 {
-                    for a in 0..2 {
-                        x[(p.pin[a], c)] += mu * p.direction[a] * v;
-                        x[(p.disc[a], c)] -= mu * p.direction[a] * v;
-                    }
+                if v != 0.0 {
+                    add_pair_load(&mut x, p, c, v, mu * v);
                 }
             }
         }

@@ -864,9 +864,10 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             // the disc's contact layer on the ring's top under the pin face, its bottom
             // tied to the ring's patch grid
             let layer = Mesh::block(&fp.xs, &fp.ys, &[0.0, *t]).with_body(body);
-            let (t, rule) = contact_layer(&mut mesh, &layer, "disc", "zmin", "zmax", pa, fp, 1)
-                .map_err(tie_error)?;
-            ties.extend(t);
+            let (layer_ties, rule) =
+                contact_layer(&mut mesh, &layer, "disc", "zmin", "zmax", pa, fp, 1)
+                    .map_err(tie_error)?;
+            ties.extend(layer_ties);
             sizes.push(rule);
         }
         let mut divisions = [rs.len() - 1, nt, zs.len() - 1];
@@ -1067,9 +1068,10 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
                     &squeal_fe::mesh::linspace(lift, lift + zp[1], nl),
                 )
                 .with_body(materials.len());
-                let (t, rule) = contact_layer(&mut mesh, &layer, "pin", "zmax", "zmin", pa, fp, nl)
-                    .map_err(tie_error)?;
-                ties.extend(t);
+                let (layer_ties, rule) =
+                    contact_layer(&mut mesh, &layer, "pin", "zmax", "zmin", pa, fp, nl)
+                        .map_err(tie_error)?;
+                ties.extend(layer_ties);
                 sizes.push(rule);
             }
         }
