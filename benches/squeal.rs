@@ -14,6 +14,8 @@
 //!   of `K~ - s M~`, complex LU of `Q(sigma)` (two smallest rigs);
 //! * `krylov/arpack_window/<dofs>`: one ARPACK shift-invert window (nev 20);
 //! * `projection/m<M>/<dofs>`: `V^T X V` of the whole operator on `M` = 100, 300 columns;
+//! * `sparse_times/{squeal,faer}/m<M>/<dofs>`: `M_c V`, squeal's blocked product against
+//!   faer's;
 //! * `dense_qep/<m>`: the dense reduced QEP at m = 100, 200, 400.
 //!
 //! Run `cargo bench --bench squeal -- --quick` (about 5 minutes on two cores), one group with
@@ -62,6 +64,7 @@ fn main() {
     factor::bench(&mut c, rigs);
     krylov::bench(&mut c, rigs);
     reduced::bench_projection(&mut c, rigs);
+    reduced::bench_sparse_times(&mut c, rigs);
     reduced::bench_dense_qep(&mut c, rigs);
     c.final_summary();
 }

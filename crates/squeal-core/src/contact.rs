@@ -303,7 +303,7 @@ impl Condensation {
                     }
                 }
                 factor.solve_in_place(x.as_mut());
-                let y = sparse_times_dense(problem.pn, x.as_ref());
+                let y = crate::linalg::sparse_times(problem.pn, x.as_ref());
                 dst.as_mut().subcols_mut(c0, b).copy_from(&y);
                 c0 += b;
             }
@@ -456,19 +456,6 @@ fn transpose(a: SparseRef<'_>) -> SparseMat {
         }
     }
     SparseMat::try_new_from_triplets(a.ncols(), a.nrows(), &t).expect("valid transpose")
-}
-
-/// `A X` for sparse `A` and dense `X`.
-pub fn sparse_times_dense(a: SparseRef<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
-    let mut y = Mat::<f64>::zeros(a.nrows(), x.ncols());
-    for j in 0..a.ncols() {
-        for (r, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
-            for c in 0..x.ncols() {
-                y[(r, c)] += v * x[(j, c)];
-            }
-        }
-    }
-    y
 }
 
 /// `y += alpha A^T x`.

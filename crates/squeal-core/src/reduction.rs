@@ -34,11 +34,11 @@
 
 use crate::contact::{Basis, BasisRequest, FrictionalOperator};
 use crate::eigen::{EigenParams, EigenSolver, RealModes, SymmetricProblem};
+pub use crate::linalg::sparse_times;
 use crate::linalg::{add_scaled, dot, spmv, Cholesky};
 use crate::qep::{finish_operator_modes, spmv_complex, ComplexModes};
 use crate::{c64, Error, Result, SparseMat, SparseRef};
 use faer::linalg::matmul::matmul;
-use faer::sparse::linalg::matmul::sparse_dense_matmul;
 use faer::sparse::Triplet;
 use faer::{Accum, Mat, MatRef, Par};
 use std::time::Instant;
@@ -56,15 +56,6 @@ const BLOCK: usize = 32;
 
 fn par() -> Par {
     faer::get_global_parallelism()
-}
-
-/// `A X` for a sparse `A` and a dense `X` (faer's sparse-dense product).
-pub fn sparse_times(a: SparseRef<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
-    let mut y = Mat::<f64>::zeros(a.nrows(), x.ncols());
-    if x.ncols() > 0 && a.nrows() > 0 {
-        sparse_dense_matmul(y.as_mut(), Accum::Replace, a, x, 1.0, par());
-    }
-    y
 }
 
 /// `A^T B` for dense matrices.
