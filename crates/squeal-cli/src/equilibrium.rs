@@ -190,6 +190,13 @@ pub fn run(
         .as_ref()
         .expect("a contact set has a grid");
     let cell = [grid.xs[1] - grid.xs[0], grid.ys[1] - grid.ys[0]];
+    let grid_cells = grid.cells();
+    let cells: Vec<[f64; 4]> = setup
+        .set
+        .grid_index
+        .iter()
+        .map(|&g| grid_cells[g])
+        .collect();
     let panels: Vec<squeal_plot::MapPanel> = eqs
         .iter()
         .map(|eq| squeal_plot::MapPanel {
@@ -202,6 +209,7 @@ pub fn run(
             xy: setup.set.xy.clone(),
             values: eq.eq.rn.clone(),
             cell,
+            cells: cells.clone(),
             arrow: Some([dir[0], dir[1]]),
             arrow_label: "disc sliding".into(),
         })

@@ -9,7 +9,9 @@
 
 use anyhow::Result;
 use squeal_analysis::study::{Record, StudyDef, StudySpec};
-use squeal_plot::{contact_map, line_chart, ChartOptions, MapPanel, Series, SeriesStyle};
+use squeal_plot::{
+    contact_map, layout_map, line_chart, ChartOptions, MapPanel, Series, SeriesStyle,
+};
 use std::path::{Path, PathBuf};
 
 /// Draws the charts of a study into `dir`; returns the files written.
@@ -162,6 +164,7 @@ fn macro_charts(
                 xy: def.grid.points_m.clone(),
                 values: cover,
                 cell: def.grid.spacing_m,
+                cells: def.grid.cells_m(),
                 arrow: arrow(def),
                 arrow_label: "disc".into(),
             });
@@ -276,6 +279,7 @@ fn meso_charts(
     // Figures 23-26: layouts that trigger (largest DvR) or suppress each coupling (stable
     // in that class although they hold the most pairs)
     let face = def.grid.face_m;
+    let cells = def.grid.cells_m();
     for &c in &def.solve.classes_hz {
         let dvr_of = |r: &Record| {
             r.unstable
@@ -325,6 +329,7 @@ fn meso_charts(
                 .map(|on| f64::from(u8::from(on)))
                 .collect(),
             cell: def.grid.spacing_m,
+            cells: cells.clone(),
             arrow: arrow(def),
             arrow_label: "disc".into(),
         };
@@ -350,10 +355,10 @@ fn meso_charts(
                 "Plateau layouts that trigger (left) or suppress (right) the coupling near {c:.0} Hz"
             )
         };
-        files.extend(contact_map(
+        files.extend(layout_map(
             &dir.join(format!("layouts_{c:.0}hz")),
             &title,
-            "pair in contact",
+            "in contact",
             &panels,
         )?);
     }

@@ -31,6 +31,7 @@ fn pad(mu: f64) -> MapPanel {
         xy,
         values,
         cell: [h, h],
+        cells: Vec::new(),
         arrow: Some([1.0, 0.0]),
         arrow_label: "sliding".into(),
     }

@@ -1,4 +1,5 @@
-//! Contact force maps: one panel per contact set, a shared colour scale.
+//! Contact maps: one panel per contact set, either a shared colour scale ([`contact_map`],
+//! e.g. the normal force) or two colours for pairs in and out of contact ([`layout_map`]).
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -23,8 +24,13 @@ pub struct MapPanel {
     /// shared viridis scale from 0 to the largest value over all panels.
     pub values: Vec<f64>,
     /// Width and height (x, y) of the square drawn for each pair, in metres
-    /// (typically the contact element size). Both must be positive.
+    /// (typically the contact element size). Both must be positive. Unused when `cells`
+    /// is given.
     pub cell: [f64; 2],
+    /// The rectangle drawn for each pair, `[x_min, x_max, y_min, y_max]` in metres (same
+    /// length as `xy`), for grids whose spacing varies (a refined contact zone); empty
+    /// draws a `cell`-sized rectangle centred on each pair.
+    pub cells: Vec<[f64; 4]>,
     /// Sliding direction in the x-y plane, drawn as an arrow from the panel centre.
     /// Normalised before drawing; `None` draws no arrow.
     pub arrow: Option<[f64; 2]>,
@@ -34,6 +40,8 @@ pub struct MapPanel {
 
 /// Colour of open pairs (value `<= 0`).
 const OPEN: RGBColor = RGBColor(222, 222, 222);
+/// Colour of closed pairs in a [`layout_map`].
+const CLOSED: RGBColor = RGBColor(31, 119, 180);
 /// Panels per row before wrapping to a grid.
 const MAX_COLS: usize = 3;
 const PANEL_W: u32 = 440;
@@ -90,7 +98,7 @@ pub(crate) fn viridis(t: f64) -> RGBColor {
 /// Writes a contact map to `<stem>.svg` and `<stem>.png` (size [`contact_map_size`]).
 ///
 /// One panel per entry of `panels`, side by side (a grid of 3 columns beyond 3 panels).
-/// Each pair is a filled rectangle of size `cell` centred at its position, coloured on a
+/// Each pair is a filled rectangle (its `cells` entry, or `cell` centred on it), coloured on a
 /// colour scale shared by all panels: light grey for open pairs (value `<= 0`), viridis
 /// from 0 to the largest value for closed pairs. A colour bar on the right is labelled
 /// `value_label` (give the unit: `"normal force (N)"`). Inputs are metres; axes are
@@ -109,6 +117,44 @@ pub fn contact_map(
     value_label: &str,
     panels: &[MapPanel],
 ) -> Result<Vec<PathBuf>, PlotError> {
+    draw_map(stem, title, Legend::Scale(value_label), panels)
+}
+
+/// Writes a contact layout map to `<stem>.svg` and `<stem>.png` (size
+/// [`contact_map_size`]): like [`contact_map`], but pairs with a positive value are drawn
+/// in one colour and open pairs (value `<= 0`) in light grey, with a two-entry legend
+/// (`closed_label`, "open") in place of the colour bar. For contact layouts, where a
+/// pair is in contact or not.
+///
+/// # Errors
+/// As [`contact_map`].
+pub fn layout_map(
+    stem: &Path,
+    title: &str,
+    closed_label: &str,
+    panels: &[MapPanel],
+) -> Result<Vec<PathBuf>, PlotError> {
+    draw_map(stem, title, Legend::TwoColours(closed_label), panels)
+}
+
+fn draw_map(
+    stem: &Path,
+    title: &str,
+    legend: Legend<'_>,
+    panels: &[MapPanel],
+) -> Result<Vec<PathBuf>, PlotError> {
+    let vmax = check_panels(stem, panels)?;
+    let fig = ContactFig {
+        title,
+        legend,
+        panels,
+        vmax,
+    };
+    render(stem, &fig)
+}
+
+/// Checks the panels of a map; returns the largest value over all of them (at least 0).
+fn check_panels(stem: &Path, panels: &[MapPanel]) -> Result<f64, PlotError> {
     if panels.is_empty() {
         return Err(PlotError::empty(stem, "no panel"));
     }
@@ -154,20 +200,63 @@ pub fn contact_map(
                 return Err(PlotError::invalid(stem, format!("{name}: zero arrow")));
             }
         }
+        if !p.cells.is_empty() {
+            if p.cells.len() != p.xy.len() {
+                return Err(PlotError::invalid(
+                    stem,
+                    format!(
+                        "{name}: {} positions but {} cells",
+                        p.xy.len(),
+                        p.cells.len()
+                    ),
+                ));
+            }
+            if let Some(i) = p
+                .cells
+                .iter()
+                .position(|c| !c.iter().all(|v| v.is_finite()))
+            {
+                return Err(PlotError::nan(stem, format!("{name}: cell of pair {i}")));
+            }
+            if let Some(i) = p.cells.iter().position(|c| c[1] <= c[0] || c[3] <= c[2]) {
+                return Err(PlotError::invalid(
+                    stem,
+                    format!(
+                        "{name}: cell of pair {i} {:?} must have x_min < x_max and \
+                         y_min < y_max",
+                        p.cells[i]
+                    ),
+                ));
+            }
+        }
         vmax = p.values.iter().fold(vmax, |m, v| m.max(*v));
     }
-    let fig = ContactFig {
-        title,
-        value_label,
-        panels,
-        vmax,
-    };
-    render(stem, &fig)
+    Ok(vmax)
+}
+
+/// What the strip right of the panels shows.
+enum Legend<'a> {
+    /// A viridis colour bar from 0 to the largest value, with this label.
+    Scale(&'a str),
+    /// One swatch for closed pairs, with this label, and one for open pairs.
+    TwoColours(&'a str),
+}
+
+/// Rectangle `[x_min, x_max, y_min, y_max]` (mm) of pair `k` of `p`.
+fn rect_mm(p: &MapPanel, k: usize) -> [f64; 4] {
+    match p.cells.get(k) {
+        Some(c) => c.map(|v| v * 1e3),
+        None => {
+            let (x, y) = (p.xy[k][0] * 1e3, p.xy[k][1] * 1e3);
+            let (hx, hy) = (0.5e3 * p.cell[0], 0.5e3 * p.cell[1]);
+            [x - hx, x + hx, y - hy, y + hy]
+        }
+    }
 }
 
 struct ContactFig<'a> {
     title: &'a str,
-    value_label: &'a str,
+    legend: Legend<'a>,
     panels: &'a [MapPanel],
     /// Largest value over all panels (0 when every pair is open).
     vmax: f64,
@@ -175,10 +264,10 @@ struct ContactFig<'a> {
 
 impl ContactFig<'_> {
     fn color(&self, v: f64) -> RGBColor {
-        if v > 0.0 && self.vmax > 0.0 {
-            viridis(v / self.vmax)
-        } else {
-            OPEN
+        match self.legend {
+            _ if v <= 0.0 || self.vmax <= 0.0 => OPEN,
+            Legend::Scale(_) => viridis(v / self.vmax),
+            Legend::TwoColours(_) => CLOSED,
         }
     }
 
@@ -194,20 +283,19 @@ impl ContactFig<'_> {
 /// Axis ranges in mm of a panel drawn in an area of `px` pixels, with equal mm per pixel
 /// on both axes and a 5 % margin.
 fn panel_ranges(p: &MapPanel, px: (u32, u32)) -> (Range<f64>, Range<f64>) {
-    let (hx, hy) = (0.5e3 * p.cell[0], 0.5e3 * p.cell[1]);
     let mut b = [
         f64::INFINITY,
         f64::NEG_INFINITY,
         f64::INFINITY,
         f64::NEG_INFINITY,
     ];
-    for q in &p.xy {
-        let (x, y) = (q[0] * 1e3, q[1] * 1e3);
+    for k in 0..p.xy.len() {
+        let r = rect_mm(p, k);
         b = [
-            b[0].min(x - hx),
-            b[1].max(x + hx),
-            b[2].min(y - hy),
-            b[3].max(y + hy),
+            b[0].min(r[0]),
+            b[1].max(r[1]),
+            b[2].min(r[2]),
+            b[3].max(r[3]),
         ];
     }
     let (cx, cy) = (0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]));
@@ -243,7 +331,14 @@ impl Figure for ContactFig<'_> {
         for (p, area) in self.panels.iter().zip(areas.iter()) {
             self.draw_panel(p, area)?;
         }
-        self.draw_colour_bar(&bar)
+        match self.legend {
+            Legend::Scale(label) => self.draw_colour_bar(&bar, label),
+            Legend::TwoColours(label) => {
+                let y = (CAPTION_H + MARGIN) as i32;
+                swatch(&bar, y, CLOSED, label)?;
+                swatch(&bar, y + 30, OPEN, "open")
+            }
+        }
     }
 }
 
@@ -272,10 +367,9 @@ impl ContactFig<'_> {
             .label_style(font(13))
             .axis_desc_style(font(15))
             .draw()?;
-        let (hx, hy) = (0.5e3 * p.cell[0], 0.5e3 * p.cell[1]);
-        chart.draw_series(p.xy.iter().zip(&p.values).map(|(q, &v)| {
-            let (x, y) = (q[0] * 1e3, q[1] * 1e3);
-            Rectangle::new([(x - hx, y + hy), (x + hx, y - hy)], self.color(v).filled())
+        chart.draw_series(p.values.iter().enumerate().map(|(k, &v)| {
+            let r = rect_mm(p, k);
+            Rectangle::new([(r[0], r[3]), (r[1], r[2])], self.color(v).filled())
         }))?;
 
         if let Some(a) = p.arrow {
@@ -329,6 +423,7 @@ impl ContactFig<'_> {
     fn draw_colour_bar<DB: DrawingBackend>(
         &self,
         bar: &DrawingArea<DB, Shift>,
+        value_label: &str,
     ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
         let (_, h) = bar.dim_in_pixel();
         let vtop = self.vtop();
@@ -342,7 +437,7 @@ impl ContactFig<'_> {
         cb.configure_mesh()
             .disable_mesh()
             .disable_x_axis()
-            .y_desc(self.value_label)
+            .y_desc(value_label)
             .y_label_formatter(&fmt_tick)
             .label_style(font(13))
             .axis_desc_style(font(15))
@@ -361,19 +456,32 @@ impl ContactFig<'_> {
             Rectangle::new([(0.0, y1), (1.0, y0)], c.filled())
         }))?;
         // Swatch for open pairs below the bar.
-        let y = h as i32 - X_LABEL_H as i32 - MARGIN as i32 + 5;
-        bar.draw(&Rectangle::new([(10, y), (34, y + 18)], OPEN.filled()))?;
-        bar.draw(&Rectangle::new(
-            [(10, y), (34, y + 18)],
-            BLACK.stroke_width(1),
-        ))?;
-        bar.draw(&Text::new(
+        swatch(
+            bar,
+            h as i32 - X_LABEL_H as i32 - MARGIN as i32 + 5,
+            OPEN,
             "open (0)",
-            (40, y + 9),
-            font(14).pos(Pos::new(HPos::Left, VPos::Center)),
-        ))?;
-        Ok(())
+        )
     }
+}
+
+/// A framed colour swatch at height `y` (pixels) of the legend strip, `label` on its right.
+fn swatch<DB: DrawingBackend>(
+    bar: &DrawingArea<DB, Shift>,
+    y: i32,
+    colour: RGBColor,
+    label: &str,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    bar.draw(&Rectangle::new([(10, y), (34, y + 18)], colour.filled()))?;
+    bar.draw(&Rectangle::new(
+        [(10, y), (34, y + 18)],
+        BLACK.stroke_width(1),
+    ))?;
+    bar.draw(&Text::new(
+        label.to_string(),
+        (40, y + 9),
+        font(14).pos(Pos::new(HPos::Left, VPos::Center)),
+    ))
 }
 
 #[cfg(test)]

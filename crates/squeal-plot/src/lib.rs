@@ -49,7 +49,7 @@ mod line;
 mod pareto;
 
 pub use bar::bar_chart;
-pub use contact::{contact_map, contact_map_size, MapPanel};
+pub use contact::{contact_map, contact_map_size, layout_map, MapPanel};
 pub use line::{line_chart, ChartOptions, Series, SeriesStyle};
 pub use pareto::{pareto_chart, pareto_front};
 

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use squeal_plot::{
-    bar_chart, contact_map, contact_map_size, line_chart, pareto_chart, pareto_front, ChartOptions,
-    MapPanel, PlotError, Series, SeriesStyle, CHART_SIZE,
+    bar_chart, contact_map, contact_map_size, layout_map, line_chart, pareto_chart, pareto_front,
+    ChartOptions, MapPanel, PlotError, Series, SeriesStyle, CHART_SIZE,
 };
 
 /// A fresh directory under the system temp dir (never the repository).
@@ -142,6 +142,7 @@ fn grid_panel(title: &str, nx: usize, ny: usize) -> MapPanel {
         xy,
         values,
         cell: [1e-3, 1e-3],
+        cells: Vec::new(),
         arrow: Some([0.0, 2.0]), // not unit: normalised by the function
         arrow_label: "sliding".into(),
     }
@@ -225,6 +226,55 @@ fn contact_map_bad_input() {
         contact_map(&stem, "t", "v", &[zero]),
         Err(PlotError::InvalidInput { .. })
     ));
+
+    let mut cells = grid_panel("c", 2, 2);
+    cells.cells = vec![[0.0, 1e-3, 0.0, 1e-3]; 3];
+    let err = contact_map(&stem, "t", "v", &[cells.clone()]).unwrap_err();
+    assert!(matches!(err, PlotError::InvalidInput { .. }), "{err}");
+    assert!(err.to_string().contains("3 cells"), "{err}");
+    cells.cells.push([1e-3, 1e-3, 0.0, 1e-3]); // x_min == x_max
+    let err = layout_map(&stem, "t", "v", &[cells.clone()]).unwrap_err();
+    assert!(err.to_string().contains("cell of pair 3"), "{err}");
+    cells.cells[3][1] = f64::NAN;
+    let err = layout_map(&stem, "t", "v", &[cells]).unwrap_err();
+    assert!(matches!(err, PlotError::NanData { .. }), "{err}");
+}
+
+#[test]
+fn layout_map_draws_two_colours_and_explicit_cells() {
+    let dir = temp_dir("layout");
+    let stem = dir.join("layouts");
+    // A refined corner: pairs of a 3 x 3 grid whose first column and row are 0.2 mm wide
+    // and the rest 1 mm, drawn with their own rectangles; values 0/1 alternate.
+    let lines = [0.0, 0.2e-3, 1.2e-3];
+    let edges = [-0.1e-3, 0.1e-3, 0.7e-3, 1.7e-3];
+    let mut panel = MapPanel {
+        title: "layout 7".into(),
+        cell: [1.0, 1.0], // would swamp the map if it were used
+        arrow: Some([-1.0, 0.0]),
+        arrow_label: "disc".into(),
+        ..MapPanel::default()
+    };
+    for j in 0..3 {
+        for i in 0..3 {
+            panel.xy.push([lines[i], lines[j]]);
+            panel
+                .cells
+                .push([edges[i], edges[i + 1], edges[j], edges[j + 1]]);
+            panel.values.push(((i + j) % 2) as f64);
+        }
+    }
+    let files = layout_map(&stem, "Layouts", "in contact", &[panel]).unwrap();
+    let svg = check_outputs(&stem, &files, contact_map_size(1));
+    // 4 closed pairs + 1 legend swatch in the closed colour, 5 open + 1 swatch in grey,
+    // and no colour bar (no viridis).
+    assert_eq!(svg.count_attr("rect", "fill", "#1F77B4"), 4 + 1);
+    assert_eq!(svg.count_attr("rect", "fill", "#DEDEDE"), 5 + 1);
+    assert_eq!(svg.count_attr("rect", "fill", "#FDE725"), 0);
+    assert!(svg.has_text("in contact") && svg.has_text("open"));
+    assert!(svg.has_text("layout 7") && svg.has_text("disc"));
+    // The axes span the cells (-0.1 to 1.7 mm), not the 1 m `cell`.
+    assert!(svg.has_text("1.5"), "{:?}", svg.texts());
 }
 
 // --------------------------------------------------------------------------- line chart

@@ -8,7 +8,9 @@
 mod model;
 mod spec;
 
-pub use model::{build, element_size, BodyKind, BodyStats, ContactGrid, Model, SizeRule};
+pub use model::{
+    build, element_size, line_cells, BodyKind, BodyStats, ContactGrid, Model, SizeRule,
+};
 pub use spec::{
     ContactRefinement, ContactSpec, Damping, Disc, Flange, Hat, ImportedMesh, Load, MaterialSpec,
     MeshImport, MeshRule, Pin, Plate, Scene, Study, Zone, BUILTIN_SCENES,

@@ -149,7 +149,42 @@ pub struct ContactGrid {
     pub max_mismatch_m: f64,
 }
 
+/// The interval each of the sorted grid `lines` stands for: bounded by the midpoints to
+/// its neighbours, and by `lo` before the first line and `hi` after the last (the face
+/// edges). On a refined grid the intervals are as fine as the lines.
+pub fn line_cells(lines: &[f64], lo: f64, hi: f64) -> Vec<[f64; 2]> {
+    let n = lines.len();
+    (0..n)
+        .map(|i| {
+            [
+                if i > 0 {
+                    0.5 * (lines[i - 1] + lines[i])
+                } else {
+                    lo
+                },
+                if i + 1 < n {
+                    0.5 * (lines[i] + lines[i + 1])
+                } else {
+                    hi
+                },
+            ]
+        })
+        .collect()
+}
+
 impl ContactGrid {
+    /// The area each pair stands for, `[x_min, x_max, y_min, y_max]` (m), pair by pair:
+    /// bounded by the midlines to the neighbouring grid lines and by the outer lines (the
+    /// face edges), so that the cells tile the contact face (see [`line_cells`]).
+    pub fn cells(&self) -> Vec<[f64; 4]> {
+        let bx = line_cells(&self.xs, self.xs[0], self.xs[self.xs.len() - 1]);
+        let by = line_cells(&self.ys, self.ys[0], self.ys[self.ys.len() - 1]);
+        self.ij
+            .iter()
+            .map(|&[i, j]| [bx[i][0], bx[i][1], by[j][0], by[j][1]])
+            .collect()
+    }
+
     /// Number of pairs.
     pub fn len(&self) -> usize {
         self.pin_nodes.len()

@@ -223,6 +223,15 @@ fn contact_grid_is_compatible_and_the_disc_stays_round() {
             epsilon = 1e-12
         );
     }
+    // each pair's cell holds it, and the cells tile the pin face
+    let cells = c.cells();
+    assert_eq!(cells.len(), c.len());
+    let mut area = 0.0;
+    for (cell, q) in cells.iter().zip(&c.xy) {
+        assert!(cell[0] <= q[0] && q[0] <= cell[1] && cell[2] <= q[1] && q[1] <= cell[3]);
+        area += (cell[1] - cell[0]) * (cell[3] - cell[2]);
+    }
+    approx::assert_relative_eq!(area, p.size_x_m * p.size_y_m, max_relative = 1e-12);
     let d = scene.disc.as_ref().unwrap();
     for &n in model.mesh.node_set("disc.outer").unwrap() {
         let x = model.mesh.nodes[n];

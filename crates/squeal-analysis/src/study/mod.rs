@@ -411,10 +411,7 @@ impl GridInfo {
     pub fn spacing_in(&self, region_m: [f64; 4]) -> [f64; 2] {
         let [x0, y0, a, b] = region_m;
         let tol = 1e-9 * self.face_m[0].max(self.face_m[1]);
-        let xs: Vec<f64> = self.points_m[..self.n[0]].iter().map(|p| p[0]).collect();
-        let ys: Vec<f64> = (0..self.n[1])
-            .map(|j| self.points_m[j * self.n[0]][1])
-            .collect();
+        let [xs, ys] = self.lines();
         let step = |v: &[f64], lo: f64, hi: f64| {
             // the lines inside, and the nearest line beyond each end
             let i0 = v.iter().rposition(|&x| x <= lo + tol).unwrap_or(0);
@@ -425,6 +422,29 @@ impl GridInfo {
                 .fold(0.0, f64::max)
         };
         [step(&xs, x0, x0 + a), step(&ys, y0, y0 + b)]
+    }
+
+    /// The grid lines along x and along y (m from the face corner).
+    fn lines(&self) -> [Vec<f64>; 2] {
+        [
+            self.points_m[..self.n[0]].iter().map(|p| p[0]).collect(),
+            (0..self.n[1])
+                .map(|j| self.points_m[j * self.n[0]][1])
+                .collect(),
+        ]
+    }
+
+    /// The area each pair stands for, `[x_min, x_max, y_min, y_max]` (m), in grid order:
+    /// bounded by the midlines to the neighbouring grid lines and by the face edges (a
+    /// pair on an edge stands for half a cell). Where the grid is refined, the cells are
+    /// as fine as the pairs.
+    pub fn cells_m(&self) -> Vec<[f64; 4]> {
+        let [xs, ys] = self.lines();
+        let bx = squeal_scene::line_cells(&xs, 0.0, self.face_m[0]);
+        let by = squeal_scene::line_cells(&ys, 0.0, self.face_m[1]);
+        by.iter()
+            .flat_map(|y| bx.iter().map(move |x| [x[0], x[1], y[0], y[1]]))
+            .collect()
     }
 
     /// Pairs of the grid inside `zone`.

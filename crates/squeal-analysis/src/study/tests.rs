@@ -438,6 +438,36 @@ fn refined_grid() -> GridInfo {
 }
 
 #[test]
+fn grid_cells_tile_the_face_and_follow_the_refinement() {
+    for g in [grid(5, 0.02), refined_grid()] {
+        let cells = g.cells_m();
+        assert_eq!(cells.len(), g.points_m.len());
+        let mut area = 0.0;
+        for (c, p) in cells.iter().zip(&g.points_m) {
+            assert!(c[0] <= p[0] && p[0] <= c[1] && c[2] <= p[1] && p[1] <= c[3]);
+            assert!(c[0] < c[1] && c[2] < c[3], "{c:?}");
+            area += (c[1] - c[0]) * (c[3] - c[2]);
+        }
+        let face = g.face_m[0] * g.face_m[1];
+        assert!((area - face).abs() < 1e-12 * face, "{area} vs {face}");
+    }
+    // inside the refined band a cell is 0.2 mm wide, outside 1 mm, half at the face edge
+    let g = refined_grid();
+    let cells = g.cells_m();
+    let width = |x: f64| {
+        let k = g
+            .points_m
+            .iter()
+            .position(|p| (p[0] - x).abs() < 1e-12)
+            .unwrap();
+        cells[k][1] - cells[k][0]
+    };
+    assert!((width(0.015) - 2e-4).abs() < 1e-12);
+    assert!((width(0.005) - 1e-3).abs() < 1e-12);
+    assert!((width(0.0) - 5e-4).abs() < 1e-12);
+}
+
+#[test]
 fn meso_patches_follow_the_grid_spacing_inside_their_region() {
     let g = refined_grid();
     let fine = g.spacing_in([0.010, 0.004, 0.010, 0.014]);
