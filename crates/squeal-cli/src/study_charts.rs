@@ -336,7 +336,7 @@ fn meso_charts(
         let mut panels: Vec<MapPanel> = trig
             .iter()
             .take(2)
-            .map(|(r, (f, d))| panel(r, format!("{}: {f:.0} Hz, DvR {d:.4}", name(r))))
+            .map(|(r, (f, d))| panel(r, format!("{}: {f:.0} Hz, DvR {}", name(r), dvr_text(*d))))
             .collect();
         panels.extend(supp.iter().take(2).map(|r| {
             panel(
@@ -363,4 +363,26 @@ fn meso_charts(
         )?);
     }
     Ok(files)
+}
+
+/// A DvR for a caption: 4 decimals, or 2 significant digits below 1e-3 (weak
+/// instabilities would read `0.0000`).
+fn dvr_text(d: f64) -> String {
+    if d.abs() >= 1e-3 {
+        format!("{d:.4}")
+    } else {
+        format!("{d:.1e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::dvr_text;
+
+    #[test]
+    fn weak_dvr_keeps_its_digits() {
+        assert_eq!(dvr_text(0.02391), "0.0239");
+        assert_eq!(dvr_text(2.69e-5), "2.7e-5");
+        assert_eq!(dvr_text(1e-3), "0.0010");
+    }
 }
