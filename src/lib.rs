@@ -2,7 +2,9 @@
 //!
 //! Brake-squeal stability analysis: the facade crate. It re-exports the workspace crates
 //! and builds the default [`Registry`] with every built-in plugin. Adding a method is one
-//! crate under `plugins/` plus one `register` line in [`registry`].
+//! crate under `plugins/` (exposing `pub fn register(reg: &mut Registry)`) plus its one
+//! dependency line in the root `Cargo.toml`: the build script finds it there and
+//! registers it.
 
 pub use squeal_analysis as analysis;
 pub use squeal_contact as contact;
@@ -11,19 +13,11 @@ pub use squeal_core::Registry;
 pub use squeal_fe as fe;
 pub use squeal_scene as scene;
 
+include!(concat!(env!("OUT_DIR"), "/plugins.rs"));
+
 /// The registry with every built-in plugin.
 pub fn registry() -> Registry {
     let mut reg = Registry::new();
-    squeal_materials::register(&mut reg);
-    squeal_contact_laws::register(&mut reg);
-    squeal_equilibrium_lorang::register(&mut reg);
-    squeal_equilibrium_lcp::register(&mut reg);
-    squeal_eigen_arpack::register(&mut reg);
-    squeal_eigen_krylov::register(&mut reg);
-    squeal_eigen_dense::register(&mut reg);
-    squeal_basis_modes::register(&mut reg);
-    squeal_basis_enriched::register(&mut reg);
-    squeal_basis_residue::register(&mut reg);
-    squeal_basis_cms::register(&mut reg);
+    register_plugins(&mut reg);
     reg
 }

@@ -127,6 +127,15 @@ fn the_comparison_counts_missed_false_and_shifted_modes() {
     let e = compare(&reference, &shifted, band, 1e-8);
     assert_eq!(e.missed_modes, 0);
     assert!((e.max_rel_freq_err - 0.005).abs() < 1e-9, "{e:?}");
+    // the full-order solve above 1000 DOFs has no error bound; added, it is recorded and
+    // the shifted mode's error (0.5 %) is far above it
+    assert!(e.max_error_bound.is_nan() && e.max_cond.is_nan(), "{e:?}");
+    squeal::core::qep::add_condition(&op, mu, &mut shifted).unwrap();
+    let e = compare(&reference, &shifted, band, 1e-8);
+    assert!(e.max_error_bound > 0.0 && e.max_error_bound < 1e-6, "{e:?}");
+    assert!(e.max_cond >= 1.0 && e.max_cond.is_finite(), "{e:?}");
+    assert_eq!(e.above_bound, 1, "{e:?}");
+    assert!((e.max_rel_lambda_err - 0.005).abs() < 1e-9, "{e:?}");
 }
 
 #[test]

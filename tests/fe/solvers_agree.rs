@@ -137,7 +137,7 @@ fn arpack_and_krylov_agree_on_the_disc() {
         params.fmax_hz
     );
 
-    // Table 2 of the paper: the default disc is fitted to it (scripts/disc_fit_lp.py)
+    // Table 2 of the paper: the default disc is fitted to it (examples/calibrate/disc.toml)
     let rows = compare_table2(&records);
     eprint!("{}", format_table(&rows));
     let errors: Vec<(String, f64)> = rows

@@ -10,6 +10,7 @@
 //! run comes from the [`Registry`] ([`BenchOptions::all`]), so a basis registered at run
 //! time is benchmarked with no change here.
 
+use crate::jsonl::{nan, null_as_nan};
 use crate::pipeline::{PipelineError, Result};
 use serde::{Deserialize, Serialize};
 use squeal_core::contact::BasisRequest;
@@ -57,8 +58,8 @@ pub struct BenchOptions {
     pub reference_eigen: String,
     /// Its tolerance.
     pub reference_tol: f64,
-    /// A mode is unstable when `Re(lambda) > unstable_tol |lambda|`.
-    pub unstable_tol: f64,
+    /// A mode is unstable when its DvR = Re/Im exceeds this.
+    pub dvr_tol: f64,
     /// Bases to run (`none` = full order).
     pub bases: Vec<String>,
     /// Eigen solvers to run (of the reduced problem when there is a basis).
@@ -72,6 +73,12 @@ pub struct BenchOptions {
     pub modal: String,
     /// The accuracy a run must reach to count as accurate.
     pub accuracy: Accuracy,
+    /// Whether full-order modes (the reference's and the full-order runs') always get
+    /// condition numbers and forward error estimates: the solvers compute them only up to
+    /// [`CONDITION_AUTO_MAX_DIM`](squeal_core::qep::CONDITION_AUTO_MAX_DIM) DOFs; above,
+    /// with this set, they are added afterwards ([`squeal_core::qep::add_condition`]) and
+    /// timed apart ([`BenchRun::condition_s`]). Reduced runs always have them.
+    pub condition: bool,
 }
 
 impl BenchOptions {
@@ -85,13 +92,14 @@ impl BenchOptions {
             tol: 1e-10,
             reference_eigen: "arpack".into(),
             reference_tol: 1e-12,
-            unstable_tol: 1e-8,
+            dvr_tol: 1e-6,
             bases,
             eigens: registry.eigen.names(),
             vary: Vec::new(),
             defaults: true,
             modal: "arpack".into(),
             accuracy: Accuracy::default(),
+            condition: false,
         }
     }
 
@@ -129,6 +137,33 @@ pub struct ModeErrors {
     /// Worst backward error (on the full operator) of the modes in the band.
     #[serde(deserialize_with = "null_as_nan")]
     pub max_backward_error: f64,
+    /// Worst forward error estimate (`error_bound`, relative eigenvalue error) of the
+    /// modes in the band; NaN when not computed (full order above
+    /// [`CONDITION_AUTO_MAX_DIM`](squeal_core::qep::CONDITION_AUTO_MAX_DIM) DOFs without
+    /// [`BenchOptions::condition`]).
+    #[serde(default = "nan", deserialize_with = "null_as_nan")]
+    pub max_error_bound: f64,
+    /// Worst condition number of the modes in the band; NaN when not computed.
+    #[serde(default = "nan", deserialize_with = "null_as_nan")]
+    pub max_cond: f64,
+    /// Largest relative eigenvalue error `|lambda - lambda_ref| / |lambda_ref|` over
+    /// matched modes (NaN when none matched): the actual error `error_bound` estimates.
+    #[serde(default = "nan", deserialize_with = "null_as_nan")]
+    pub max_rel_lambda_err: f64,
+    /// Matched modes whose relative eigenvalue error exceeds their own `error_bound` by
+    /// more than the reference's accuracy ([`BOUND_FLOOR`], or the reference mode's own
+    /// bound when larger); modes without a bound are not counted.
+    #[serde(default)]
+    pub above_bound: usize,
+}
+
+/// The smallest eigenvalue error a bound is held to: below it the reference itself
+/// (solved to 1e-12) is not accurate enough to tell.
+pub const BOUND_FLOOR: f64 = 1e-12;
+
+/// The largest of `values` that are not NaN (NaN when all are, or there are none).
+fn worst(values: impl Iterator<Item = f64>) -> f64 {
+    values.fold(f64::NAN, |m, v| if v.is_nan() || m >= v { m } else { v })
 }
 
 impl ModeErrors {
@@ -143,6 +178,10 @@ impl ModeErrors {
             missed_unstable: 0,
             false_unstable: 0,
             max_backward_error: f64::NAN,
+            max_error_bound: f64::NAN,
+            max_cond: f64::NAN,
+            max_rel_lambda_err: f64::NAN,
+            above_bound: 0,
         }
     }
 
@@ -160,12 +199,15 @@ impl ModeErrors {
 /// matched to the nearest unused eigenvalue of `modes` within 1 % in frequency (none
 /// there: missed); modes of `modes` up to 1 % beyond the band edges may be
 /// partners (a mode at the edge may fall either side), those inside the band and matched
-/// to nothing are extra. A mode is unstable when `Re(lambda) > unstable_tol |lambda|`.
+/// to nothing are extra. A mode is unstable when its DvR exceeds `dvr_tol`. The worst
+/// `error_bound` and `cond` of the modes in the band are recorded next to their worst
+/// backward error, with the actual relative eigenvalue errors of the matched modes and how
+/// many exceed their own bound.
 pub fn compare(
     reference: &ComplexModes,
     modes: &ComplexModes,
     band_hz: [f64; 2],
-    unstable_tol: f64,
+    dvr_tol: f64,
 ) -> ModeErrors {
     let in_band = |f: f64| f >= band_hz[0] && f <= band_hz[1];
     let near_band = |f: f64| f >= band_hz[0] * 0.99 && f <= band_hz[1] * 1.01;
@@ -173,13 +215,14 @@ pub fn compare(
         max_rel_freq_err: 0.0,
         max_abs_dvr_err: 0.0,
         max_backward_error: 0.0,
+        max_rel_lambda_err: 0.0,
         ..ModeErrors::failed()
     };
     let mut used = vec![false; modes.len()];
     let mut matched = 0;
     for i in (0..reference.len()).filter(|&i| in_band(reference.freq_hz[i])) {
         e.reference_modes += 1;
-        let unstable_ref = reference.is_unstable(i, unstable_tol);
+        let unstable_ref = reference.is_unstable(i, dvr_tol);
         e.reference_unstable += usize::from(unstable_ref);
         // the nearest eigenvalue among the unused modes within 1 % in frequency: a strongly
         // unstable mode's nearest eigenvalue can be a mode of another frequency
@@ -198,11 +241,19 @@ pub fn compare(
         let df = rel_df(j);
         used[j] = true;
         matched += 1;
+        let err = (reference.lambda[i] - modes.lambda[j]).norm() / reference.lambda[i].norm();
+        e.max_rel_lambda_err = e.max_rel_lambda_err.max(err);
+        let floor = match reference.error_bound.get(i) {
+            Some(&b) if b.is_finite() => b.max(BOUND_FLOOR),
+            _ => BOUND_FLOOR,
+        };
+        let bound = modes.error_bound.get(j).copied().unwrap_or(f64::NAN);
+        e.above_bound += usize::from(err > bound + floor);
         e.max_rel_freq_err = e.max_rel_freq_err.max(df);
         e.max_abs_dvr_err = e
             .max_abs_dvr_err
             .max((modes.dvr[j] - reference.dvr[i]).abs());
-        let unstable = modes.is_unstable(j, unstable_tol);
+        let unstable = modes.is_unstable(j, dvr_tol);
         if unstable_ref && !unstable {
             e.missed_unstable += 1;
         } else if unstable && !unstable_ref {
@@ -213,19 +264,21 @@ pub fn compare(
         e.max_backward_error = e.max_backward_error.max(modes.backward_error[j]);
         if !used[j] {
             e.extra_modes += 1;
-            e.false_unstable += usize::from(modes.is_unstable(j, unstable_tol));
+            e.false_unstable += usize::from(modes.is_unstable(j, dvr_tol));
         }
     }
+    let band: Vec<usize> = (0..modes.len())
+        .filter(|&j| in_band(modes.freq_hz[j]))
+        .collect();
+    let at = |v: &[f64], j: usize| v.get(j).copied().unwrap_or(f64::NAN);
+    e.max_error_bound = worst(band.iter().map(|&j| at(&modes.error_bound, j)));
+    e.max_cond = worst(band.iter().map(|&j| at(&modes.cond, j)));
     if matched == 0 {
         e.max_rel_freq_err = f64::NAN;
         e.max_abs_dvr_err = f64::NAN;
+        e.max_rel_lambda_err = f64::NAN;
     }
     e
-}
-
-/// JSON writes NaN (an error that could not be measured) as `null`; read it back as NaN.
-fn null_as_nan<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
-    Option::<f64>::deserialize(d).map(|v| v.unwrap_or(f64::NAN))
 }
 
 /// One benchmark run: one (basis, parameters, eigen solver) on one operator at one mu.
@@ -260,6 +313,10 @@ pub struct BenchRun {
     pub expansion_s: Option<f64>,
     /// Peak heap above what was in use when the run started (MB), when measured.
     pub peak_mb: Option<f64>,
+    /// Left eigenvectors added to full-order modes for `cond` and `error_bound`
+    /// ([`BenchOptions::condition`]), not counted in `solve_s` (s).
+    #[serde(default)]
+    pub condition_s: Option<f64>,
     /// Basis size (0 for full order).
     pub basis_size: usize,
     /// DOFs of the (constrained) operator.
@@ -303,6 +360,9 @@ pub struct ReferenceSolve {
     /// Worst backward error in the band.
     #[serde(deserialize_with = "null_as_nan")]
     pub max_backward_error: f64,
+    /// Worst forward error estimate in the band (NaN when not computed).
+    #[serde(default = "nan", deserialize_with = "null_as_nan")]
+    pub max_error_bound: f64,
 }
 
 fn core(stage: String) -> impl FnOnce(squeal_core::Error) -> PipelineError {
@@ -416,15 +476,16 @@ pub fn bench_case(
     // the reference
     let meter = Meter::start(memory);
     let t = Instant::now();
-    let reference = create(&opts.reference_eigen)?
+    let mut reference = create(&opts.reference_eigen)?
         .solve_frictional(op, mu, &opts.params(opts.reference_tol))
         .map_err(core(format!(
             "reference `{}` at mu = {mu} ({case})",
             opts.reference_eigen
         )))?;
     let ref_time = t.elapsed().as_secs_f64();
+    let ref_condition_s = with_condition(opts, op, mu, &mut reference)?;
     let ref_peak = meter.peak_mb();
-    let self_errors = compare(&reference, &reference, opts.band_hz, opts.unstable_tol);
+    let self_errors = compare(&reference, &reference, opts.band_hz, opts.dvr_tol);
     let in_band = |f: f64| f >= opts.band_hz[0] && f <= opts.band_hz[1];
     let ref_out = ReferenceSolve {
         case: case.into(),
@@ -436,12 +497,11 @@ pub fn bench_case(
         peak_mb: ref_peak,
         modes: self_errors.reference_modes,
         unstable: (0..reference.len())
-            .filter(|&i| {
-                in_band(reference.freq_hz[i]) && reference.is_unstable(i, opts.unstable_tol)
-            })
+            .filter(|&i| in_band(reference.freq_hz[i]) && reference.is_unstable(i, opts.dvr_tol))
             .map(|i| [reference.freq_hz[i], reference.dvr[i]])
             .collect(),
         max_backward_error: self_errors.max_backward_error,
+        max_error_bound: self_errors.max_error_bound,
     };
     let mut runs = Vec::new();
     let mut push = |mut run: BenchRun, runs: &mut Vec<BenchRun>| {
@@ -468,6 +528,7 @@ pub fn bench_case(
         reduced_solve_s: None,
         expansion_s: None,
         peak_mb: None,
+        condition_s: None,
         basis_size: 0,
         dofs: op.dim(),
         tol: opts.tol,
@@ -481,6 +542,7 @@ pub fn bench_case(
             reference: true,
             solve_s: ref_time,
             peak_mb: ref_peak,
+            condition_s: ref_condition_s,
             tol: opts.reference_tol,
             errors: self_errors,
             ..blank("none", "", &opts.reference_eigen)
@@ -498,9 +560,16 @@ pub fn bench_case(
                     s.solve_frictional(op, mu, &params)
                         .map_err(core(format!("`{eigen}` at mu = {mu}")))
                 }) {
-                    Ok(modes) => {
+                    Ok(mut modes) => {
                         run.solve_s = t.elapsed().as_secs_f64();
-                        run.errors = compare(&reference, &modes, opts.band_hz, opts.unstable_tol);
+                        match with_condition(opts, op, mu, &mut modes) {
+                            Ok(c) => {
+                                run.condition_s = c;
+                                run.errors =
+                                    compare(&reference, &modes, opts.band_hz, opts.dvr_tol);
+                            }
+                            Err(e) => run.status = format!("error: {e}"),
+                        }
                     }
                     Err(e) => {
                         run.solve_s = t.elapsed().as_secs_f64();
@@ -570,7 +639,7 @@ pub fn bench_case(
                         run.solve_s = t.elapsed().as_secs_f64();
                         run.reduced_solve_s = Some(r.solve_time_s);
                         run.expansion_s = Some(r.expansion_time_s);
-                        run.errors = compare(&reference, &r.modes, opts.band_hz, opts.unstable_tol);
+                        run.errors = compare(&reference, &r.modes, opts.band_hz, opts.dvr_tol);
                     }
                     Err(e) => {
                         run.solve_s = t.elapsed().as_secs_f64();
@@ -583,6 +652,23 @@ pub fn bench_case(
         }
     }
     Ok((ref_out, runs))
+}
+
+/// Adds condition numbers to full-order `modes` when `opts.condition` asks for them and
+/// the solver skipped them; returns the time spent (`None` when nothing was done).
+fn with_condition(
+    opts: &BenchOptions,
+    op: &FrictionalOperator,
+    mu: f64,
+    modes: &mut ComplexModes,
+) -> Result<Option<f64>> {
+    if !opts.condition || modes.left_vectors.is_some() {
+        return Ok(None);
+    }
+    let t = Instant::now();
+    squeal_core::qep::add_condition(op, mu, modes)
+        .map_err(core(format!("condition numbers at mu = {mu}")))?;
+    Ok(Some(t.elapsed().as_secs_f64()))
 }
 
 /// The speed-up at equal accuracy of each (basis, eigen) over the reference: for every

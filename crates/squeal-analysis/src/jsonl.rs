@@ -106,3 +106,16 @@ pub fn first_difference(a: &serde_json::Value, b: &serde_json::Value) -> String 
     }
     go(a, b, "")
 }
+
+/// NaN: the serde default of a number that older records do not have (a quantity that
+/// was not computed).
+pub fn nan() -> f64 {
+    f64::NAN
+}
+
+/// JSON writes NaN (a quantity not computed, an error not measured) as `null`; reads it
+/// back as NaN.
+pub fn null_as_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    use serde::Deserialize;
+    Option::<f64>::deserialize(d).map(|v| v.unwrap_or(f64::NAN))
+}

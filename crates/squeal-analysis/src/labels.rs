@@ -105,6 +105,13 @@ pub fn label_disc(mesh: &Mesh, weights: &[f64], nodes: &[usize], u: &[f64]) -> D
     for (i, c) in cyl.iter().enumerate() {
         rings.entry(key(c.0, c.2)).or_default().push(i);
     }
+    // A radius bin that catches only a few nodes (where the binning cuts across the
+    // blended patch or a thin part such as the hat) is not a ring and would cap the
+    // resolvable harmonic: keep the rings of at least a quarter of the median size.
+    let mut sizes: Vec<usize> = rings.values().map(Vec::len).collect();
+    sizes.sort_unstable();
+    let median = sizes.get(sizes.len() / 2).copied().unwrap_or(0);
+    rings.retain(|_, ring| 4 * ring.len() >= median);
     let ring_weight =
         |ring: &[usize]| -> f64 { ring.iter().map(|&i| weights[nodes[i]]).sum::<f64>() };
     let nmax = rings.values().map(|v| v.len()).min().unwrap_or(2) / 2;

@@ -4,13 +4,17 @@
 //! ([`pipeline`]: model, contact, equilibrium, operator, complex modes), normal modes of a
 //! built scene ([`modal`]), automatic mode labels ([`labels`]) and the paper's reference
 //! values ([`reference`](mod@reference)), method benchmarks ([`bench`](mod@bench)),
-//! sweeps ([`sweep`]) and long studies over contact zones ([`study`]), with their
+//! sweeps over mu or any parameter of an operator family ([`sweep`], [`family`],
+//! [`mu_sweep`]) and long studies over contact zones ([`study`]), with their
 //! JSON-lines records ([`jsonl`]).
 
 pub mod bench;
+pub mod calibrate;
+pub mod family;
 pub mod jsonl;
 pub mod labels;
 pub mod modal;
+pub mod mu_sweep;
 pub mod pipeline;
 pub mod reference;
 pub mod study;

@@ -2,7 +2,7 @@
 //! it, pair doublets, and compare the disc with the paper's Table 2.
 
 use crate::labels::{body_shares, label_disc, label_pin, nodal_weights};
-use crate::reference::TABLE2;
+use crate::reference::paper;
 use serde::Serialize;
 use squeal_core::{EigenParams, EigenSolver, RealModes, Result, SymmetricProblem};
 use squeal_scene::Model;
@@ -122,9 +122,11 @@ pub struct TableRow {
 
 /// Compares labelled disc modes with Table 2 of the paper.
 pub fn compare_table2(modes: &[ModeRecord]) -> Vec<TableRow> {
-    TABLE2
+    paper()
+        .disc_modes
         .iter()
-        .map(|&(label, paper_hz, paper_double)| {
+        .map(|d| {
+            let (label, paper_hz, paper_double) = (d.label.as_str(), d.freq_hz, d.double);
             let first = modes.iter().find(|m| m.body == "disc" && m.label == label);
             let (squeal_hz, split) = match first {
                 None => (None, None),

@@ -26,6 +26,9 @@ pub enum PipelineError {
     /// Contact set-up or equilibrium.
     #[error(transparent)]
     Contact(#[from] ContactError),
+    /// Reading or evaluating an operator directory.
+    #[error(transparent)]
+    Io(#[from] squeal_io::IoError),
     /// Plugins and solvers.
     #[error("{stage}: {source}")]
     Core {
@@ -97,6 +100,19 @@ impl Prepared {
         law: &str,
         mu: f64,
     ) -> Result<LoadedEquilibrium> {
+        self.equilibrium_with(registry, solver, law, &Params::new(), mu)
+    }
+
+    /// [`equilibrium`](Self::equilibrium) with parameters for the contact law (a
+    /// penalty's stiffness).
+    pub fn equilibrium_with(
+        &self,
+        registry: &Registry,
+        solver: &str,
+        law: &str,
+        law_params: &Params,
+        mu: f64,
+    ) -> Result<LoadedEquilibrium> {
         squeal_contact::check_user_mu(mu)?;
         let s = registry
             .equilibrium
@@ -104,7 +120,7 @@ impl Prepared {
             .map_err(core("equilibrium solver"))?;
         let l = registry
             .contact_laws
-            .create(law, &Params::new())
+            .create(law, law_params)
             .map_err(core("contact law"))?;
         let prob = problem(&self.model, &self.set, &self.f, &self.g0);
         Ok(solve_on(
@@ -256,28 +272,7 @@ pub fn sweep_point(
     mu: f64,
     active_pairs: usize,
 ) -> crate::sweep::SweepPoint {
-    let out = (0..modes.len())
-        .map(|i| {
-            let uc: Vec<squeal_core::c64> = modes.vectors.col(i).iter().copied().collect();
-            let u = op.expand(&uc);
-            crate::sweep::SweepMode {
-                freq_hz: modes.freq_hz[i],
-                re: modes.lambda[i].re,
-                dvr: modes.dvr[i],
-                backward_error: modes.backward_error[i],
-                signature: crate::sweep::signature(free.mphi.as_ref(), &u),
-            }
-        })
-        .collect();
-    crate::sweep::SweepPoint {
-        mu,
-        active_pairs,
-        rebuilt: false,
-        active_hash: 0,
-        basis_size: 0,
-        times_s: [0.0; 3],
-        modes: out,
-    }
+    crate::family::sweep_point(op, modes, free, mu, mu, active_pairs)
 }
 
 /// What the solve step of a sweep returns: the modes, the basis size (0 for full order)
@@ -302,61 +297,17 @@ pub fn run_mu_sweep(
     free: &FreeModes,
     checkpoint: Option<&crate::sweep::Checkpoint>,
     mut solve: impl FnMut(&FrictionalOperator, f64, bool) -> Result<StepResult>,
-    mut progress: impl FnMut(&crate::sweep::SweepPoint),
+    progress: impl FnMut(&crate::sweep::SweepPoint),
 ) -> Result<Vec<crate::sweep::SweepPoint>> {
-    let done = match checkpoint {
-        Some(c) => c.load().map_err(|e| PipelineError::Core {
-            stage: "reading the sweep checkpoint".into(),
-            source: squeal_core::Error::Invalid(e.to_string()),
-        })?,
-        None => Vec::new(),
-    };
-    let mut points: Vec<crate::sweep::SweepPoint> = Vec::new();
-    let mut current: Option<(Vec<bool>, FrictionalOperator)> = None;
-    for &mu in mus {
-        let prev_hash = points.last().map(|p| p.active_hash);
-        if let Some(p) = done
-            .iter()
-            .find(|p| (p.mu - mu).abs() <= 1e-12 * (1.0 + mu.abs()))
-        {
-            progress(p);
-            points.push(p.clone());
-            continue;
-        }
-        let t0 = Instant::now();
-        let eq = prep.equilibrium(registry, equilibrium, law, mu)?;
-        let t_eq = t0.elapsed().as_secs_f64();
-        let t1 = Instant::now();
-        // a new operator when the contact set changed or none was built in this run (a
-        // resumed sweep or a shard starts without one)
-        let op_changed = !matches!(&current, Some((a, _)) if *a == eq.eq.active);
-        if op_changed {
-            current = Some((eq.eq.active.clone(), prep.operator(&eq.eq.active)?));
-        }
-        let t_op = t1.elapsed().as_secs_f64();
-        let op = &current.as_ref().expect("operator built").1;
-        let (modes, basis_size, basis_time) = solve(op, mu, op_changed)?;
-        let mut pt = sweep_point(
-            op,
-            &modes,
-            free,
-            mu,
-            eq.eq.active.iter().filter(|&&a| a).count(),
-        );
-        pt.active_hash = crate::sweep::active_hash(&eq.eq.active);
-        pt.rebuilt = prev_hash != Some(pt.active_hash);
-        pt.basis_size = basis_size;
-        pt.times_s = [t_eq, t_op + basis_time, modes.info.time_s];
-        if let Some(c) = checkpoint {
-            c.append(&pt).map_err(|e| PipelineError::Core {
-                stage: "writing the sweep checkpoint".into(),
-                source: squeal_core::Error::Invalid(e.to_string()),
-            })?;
-        }
-        progress(&pt);
-        points.push(pt);
-    }
-    Ok(points)
+    let mut family = crate::family::SceneMu::new(prep, registry, equilibrium, law);
+    crate::family::sweep_points(
+        &mut family,
+        mus,
+        free,
+        checkpoint,
+        |_, op, mu, changed| solve(op, mu, changed),
+        progress,
+    )
 }
 
 /// How the complex modes of an operator are computed: full order with one eigen solver,
@@ -373,6 +324,7 @@ pub struct Method {
     params: EigenParams,
     cached: Option<squeal_core::reduction::ReducedOperator>,
     free: Option<Arc<FreeInterface>>,
+    condition: bool,
     last: StepTimes,
 }
 
@@ -387,6 +339,9 @@ pub struct StepTimes {
     pub solve_s: f64,
     /// Expanding the reduced modes and their backward errors on the full operator.
     pub expansion_s: f64,
+    /// Left eigenvectors added to full-order modes for their condition numbers (see
+    /// [`Method::set_condition`]).
+    pub condition_s: f64,
 }
 
 impl Method {
@@ -425,8 +380,19 @@ impl Method {
             params,
             cached: None,
             free: None,
+            condition: false,
             last: StepTimes::default(),
         })
+    }
+
+    /// Whether full-order modes always get condition numbers and forward error
+    /// estimates: the eigen solvers compute them only up to
+    /// [`CONDITION_AUTO_MAX_DIM`](squeal_core::qep::CONDITION_AUTO_MAX_DIM) DOFs, and with
+    /// this set they are added above that ([`squeal_core::qep::add_condition`], one
+    /// factorization per mode, timed in [`StepTimes::condition_s`]). Reduced solves
+    /// always have them.
+    pub fn set_condition(&mut self, always: bool) {
+        self.condition = always;
     }
 
     /// The free-interface cutoff (Hz) the basis asks for, `None` when it needs no
@@ -470,7 +436,7 @@ impl Method {
     /// size (0 for full order) and the time spent on the basis and projection (s).
     pub fn solve(&mut self, op: &FrictionalOperator, mu: f64, rebuilt: bool) -> Result<StepResult> {
         let Some(basis) = &self.basis else {
-            let modes = self
+            let mut modes = self
                 .eigen
                 .solve_frictional(op, mu, &self.params)
                 .map_err(core(&format!("`{}` at mu = {mu}", self.eigen_name)))?;
@@ -478,6 +444,14 @@ impl Method {
                 solve_s: modes.info.time_s,
                 ..StepTimes::default()
             };
+            if self.condition {
+                let t = Instant::now();
+                squeal_core::qep::add_condition(op, mu, &mut modes).map_err(core(&format!(
+                    "condition numbers of the `{}` modes at mu = {mu}",
+                    self.eigen_name
+                )))?;
+                self.last.condition_s = t.elapsed().as_secs_f64();
+            }
             return Ok((modes, 0, 0.0));
         };
         let stale = rebuilt

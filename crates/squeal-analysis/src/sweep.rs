@@ -1,26 +1,30 @@
-//! Friction-coefficient sweeps: mode tracking by MAC continuity and coupling detection.
+//! Sweeps (of the friction coefficient, or of any parameter of an operator family, see
+//! [`crate::family`]): mode tracking by MAC continuity and coupling detection.
 //!
 //! Every complex mode of a sweep point is summarized by its **signature**: its
-//! coefficients on the free-interface normal modes `phi_k` of the bodies (no contact,
-//! `M`-orthonormal), `c_k = phi_k^T M u` on the full DOFs. Two modes are compared by the
-//! Hermitian MAC of their signatures, `|c_a^H c_b|^2 / (|c_a|^2 |c_b|^2)`, which is the MAC
-//! of the modes projected on the free-interface basis: cheap to store (one short complex
+//! coefficients on real reference modes `phi_k` (`M`-orthonormal), `c_k = phi_k^T M u` on
+//! the full DOFs. For a scene the reference modes are the free-interface normal modes of
+//! the bodies (no contact); for an operator without a model (a parametric operator
+//! directory) they are the real modes of the symmetric part of its mass and stiffness at
+//! the sweep's first value ([`crate::family::reference_modes`]). Two modes are compared by
+//! the Hermitian MAC of their signatures, `|c_a^H c_b|^2 / (|c_a|^2 |c_b|^2)`, which is the
+//! MAC of the modes projected on the reference basis: cheap to store (one short complex
 //! vector per mode, however many DOFs), independent of the contact set (whose constrained
-//! spaces differ from mu to mu), and it is also the paper's Figure 7 (MAC of each unstable
-//! mode against the free-interface modes).
+//! spaces differ from mu to mu), and for a scene it is also the paper's Figure 7 (MAC of
+//! each unstable mode against the free-interface modes).
 //!
-//! **Tracking.** Branches are continued from one mu to the next by a greedy assignment on
-//! the product of the signature MAC and a frequency-proximity factor; a mode that matches
-//! no branch above `min_mac` starts a new branch. Disc doublets (two modes with nearly the
-//! same frequency and signatures spanning the same pair of free-interface modes) are the
-//! hard case: the greedy assignment takes the best MAC first, so a rotated doublet stays on
-//! its two branches as long as the pair keeps its subspace.
+//! **Tracking.** Branches are continued from one sweep point to the next by a greedy
+//! assignment on the product of the signature MAC and a frequency-proximity factor; a mode
+//! that matches no branch above `min_mac` starts a new branch. Disc doublets (two modes
+//! with nearly the same frequency and signatures spanning the same pair of free-interface
+//! modes) are the hard case: the greedy assignment takes the best MAC first, so a rotated
+//! doublet stays on its two branches as long as the pair keeps its subspace.
 //!
 //! **Couplings.** A coupling is a maximal run of consecutive sweep points where a branch is
-//! unstable (`DvR > dvr_tol`); it reports the frequency at the largest DvR, the mu interval
-//! (first and last unstable mu), the largest DvR and the partner branch: the branch with the
-//! nearest frequency and the most negative DvR over the same interval (the mode it merged
-//! with, whose DvR mirrors it).
+//! unstable (`DvR > dvr_tol`); it reports the frequency at the largest DvR, the interval of
+//! the swept value (first and last unstable value), the largest DvR and the partner
+//! branch: the branch with the nearest frequency and the most negative DvR over the same
+//! interval (the mode it merged with, whose DvR mirrors it).
 
 use serde::{Deserialize, Serialize};
 
@@ -36,7 +40,7 @@ pub fn active_hash(active: &[bool]) -> u64 {
 use squeal_core::c64;
 
 /// One mode of a sweep point.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SweepMode {
     /// Frequency (Hz).
     pub freq_hz: f64,
@@ -46,13 +50,54 @@ pub struct SweepMode {
     pub dvr: f64,
     /// Backward error on the full operator.
     pub backward_error: f64,
-    /// Coefficients on the free-interface modes: (re, im) pairs.
+    /// Condition number of the eigenvalue (`ComplexModes::cond`); NaN when not computed
+    /// (and in checkpoints written before it was recorded).
+    #[serde(
+        default = "crate::jsonl::nan",
+        deserialize_with = "crate::jsonl::null_as_nan"
+    )]
+    pub cond: f64,
+    /// First-order estimate of the relative eigenvalue error, `cond * backward_error`
+    /// (`ComplexModes::error_bound`); NaN when not computed.
+    #[serde(
+        default = "crate::jsonl::nan",
+        deserialize_with = "crate::jsonl::null_as_nan"
+    )]
+    pub error_bound: f64,
+    /// Coefficients on the reference modes of tracking (the free-interface modes of a
+    /// scene): (re, im) pairs.
     pub signature: Vec<[f64; 2]>,
 }
 
-/// One friction coefficient of a sweep.
+/// Equal numbers, or both NaN (a quantity not computed on either side).
+fn same_number(a: f64, b: f64) -> bool {
+    a == b || (a.is_nan() && b.is_nan())
+}
+
+impl PartialEq for SweepMode {
+    /// Field by field, a NaN equal to a NaN (`cond` and `error_bound` not computed).
+    fn eq(&self, o: &Self) -> bool {
+        same_number(self.freq_hz, o.freq_hz)
+            && same_number(self.re, o.re)
+            && same_number(self.dvr, o.dvr)
+            && same_number(self.backward_error, o.backward_error)
+            && same_number(self.cond, o.cond)
+            && same_number(self.error_bound, o.error_bound)
+            && self.signature == o.signature
+    }
+}
+
+/// One value of a sweep's parameter.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct SweepPoint {
+    /// The swept parameter's value (the friction coefficient of a mu sweep; NaN in
+    /// checkpoints written before it was recorded, which [`Checkpoint::load`] sets to
+    /// `mu`).
+    #[serde(
+        default = "crate::jsonl::nan",
+        deserialize_with = "crate::jsonl::null_as_nan"
+    )]
+    pub value: f64,
     /// Friction coefficient.
     pub mu: f64,
     /// Active contact pairs.
@@ -86,10 +131,10 @@ pub struct Branch {
 pub struct Coupling {
     /// Frequency at the largest DvR (Hz).
     pub freq_hz: f64,
-    /// First unstable mu.
-    pub mu_from: f64,
-    /// Last unstable mu of the run.
-    pub mu_to: f64,
+    /// First unstable value of the swept parameter.
+    pub from: f64,
+    /// Last unstable value of the run.
+    pub to: f64,
     /// Largest divergence rate.
     pub max_dvr: f64,
     /// The unstable branch and its partner branch (when found).
@@ -235,16 +280,16 @@ pub fn couplings(points: &[SweepPoint], branches: &[Branch], dvr_tol: f64) -> Ve
             partners.extend(partner);
             out.push(Coupling {
                 freq_hz: f,
-                mu_from: points[start].mu,
-                mu_to: points[end].mu,
+                from: points[start].value,
+                to: points[end].value,
                 max_dvr: dmax,
                 partners,
             });
         }
     }
     out.sort_by(|a, b| {
-        a.mu_from
-            .total_cmp(&b.mu_from)
+        a.from
+            .total_cmp(&b.from)
             .then(a.freq_hz.total_cmp(&b.freq_hz))
     });
     out
@@ -265,7 +310,11 @@ impl Checkpoint {
     /// Points already computed (a truncated last line, from a crash mid-write, is
     /// ignored).
     pub fn load(&self) -> std::io::Result<Vec<SweepPoint>> {
-        crate::jsonl::load(&self.path)
+        let mut points: Vec<SweepPoint> = crate::jsonl::load(&self.path)?;
+        for p in points.iter_mut().filter(|p| p.value.is_nan()) {
+            p.value = p.mu;
+        }
+        Ok(points)
     }
 
     /// Records the inputs the points depend on (scene, methods, band) next to the
@@ -319,12 +368,15 @@ mod tests {
             re: dvr * 2.0 * std::f64::consts::PI * f,
             dvr,
             backward_error: 0.0,
+            cond: f64::NAN,
+            error_bound: f64::NAN,
             signature: sig.iter().map(|&x| [x, 0.0]).collect(),
         }
     }
 
     fn point(mu: f64, modes: Vec<SweepMode>) -> SweepPoint {
         SweepPoint {
+            value: mu,
             mu,
             active_pairs: 1,
             rebuilt: false,
@@ -383,8 +435,8 @@ mod tests {
         let c = couplings(&pts, &br, 1e-6);
         assert_eq!(c.len(), 1, "{c:?}");
         let c = &c[0];
-        approx::assert_abs_diff_eq!(c.mu_from, 0.4, epsilon = 1e-12);
-        approx::assert_abs_diff_eq!(c.mu_to, 0.7, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(c.from, 0.4, epsilon = 1e-12);
+        approx::assert_abs_diff_eq!(c.to, 0.7, epsilon = 1e-12);
         approx::assert_abs_diff_eq!(c.freq_hz, 2050.0, epsilon = 1e-9);
         assert!(c.max_dvr > 0.009);
         assert_eq!(c.partners.len(), 2, "the stable mirror is the partner");
@@ -408,6 +460,26 @@ mod tests {
         write!(f, "{{\"mu\": 0.2, \"act").unwrap();
         let back = ck.load().unwrap();
         assert_eq!(back, pts[..2].to_vec());
+        std::fs::remove_file(&path).ok();
+    }
+
+    #[test]
+    fn checkpoints_without_value_cond_or_error_bound_still_load() {
+        let path =
+            std::env::temp_dir().join(format!("squeal-ckpt-old-{}.jsonl", std::process::id()));
+        // a point as written before the swept value and the error estimates were recorded
+        let old = r#"{"mu":0.25,"active_pairs":3,"rebuilt":true,"active_hash":7,"basis_size":0,"times_s":[0.0,0.0,0.0],"modes":[{"freq_hz":1000.0,"re":-1.0,"dvr":-1e-4,"backward_error":1e-15,"signature":[[1.0,0.0]]}]}"#;
+        std::fs::write(&path, format!("{old}\n")).unwrap();
+        let back = Checkpoint::new(&path).load().unwrap();
+        assert_eq!(back.len(), 1);
+        assert_eq!(back[0].value, 0.25);
+        let m = &back[0].modes[0];
+        assert!(m.cond.is_nan() && m.error_bound.is_nan());
+        // and a NaN written back (as null) reads as NaN: the point equals itself
+        Checkpoint::new(&path).append(&back[0]).unwrap();
+        let again = Checkpoint::new(&path).load().unwrap();
+        assert_eq!(again.len(), 2);
+        assert_eq!(again[1], back[0]);
         std::fs::remove_file(&path).ok();
     }
 

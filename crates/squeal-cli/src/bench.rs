@@ -27,13 +27,155 @@ impl MemoryProbe for HeapProbe {
     }
 }
 
+/// `squeal bench`.
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    #[command(flatten)]
+    scene: crate::opts::SceneArg,
+    /// Operator directory (as written by `squeal export`, or parametric with --param)
+    /// instead of a scene.
+    #[arg(long)]
+    operator: Option<PathBuf>,
+    /// The parameter of a parametric operator directory (--operator), `NAME=VALUE` with
+    /// the name its operator.toml declares, e.g. `W=5`.
+    #[arg(long, value_name = "NAME=VALUE")]
+    param: Option<String>,
+    /// Condition numbers and forward error estimates also for full-order modes above 1000
+    /// DOFs (reference included; one extra factorization per mode, timed apart as
+    /// `condition_s`): without it those runs have no `error_bound`.
+    #[arg(long)]
+    condition: bool,
+    /// Friction coefficients, comma separated (one operator each).
+    #[arg(long, value_delimiter = ',', default_value = "0.3,0.7")]
+    mu: Vec<f64>,
+    /// Bases, comma separated (`none` = full order); default: `none` and every
+    /// registered basis.
+    #[arg(long, value_delimiter = ',')]
+    bases: Vec<String>,
+    /// Eigen solvers, comma separated; default: every registered one.
+    #[arg(long, value_delimiter = ',')]
+    eigens: Vec<String>,
+    /// Basis parameter variants run besides the defaults, `key=v1,v2` (by every basis
+    /// that accepts the key); `--vary none` for defaults only.
+    #[arg(long, default_value = "cutoff_factor=2.5")]
+    vary: Vec<String>,
+    /// Frequency band `FMIN:FMAX` (Hz); default: the scene's `study.band_hz`.
+    #[arg(long)]
+    band: Option<String>,
+    /// Relative tolerance of the benchmarked eigen solvers.
+    #[arg(long, default_value = "1e-10")]
+    tol: f64,
+    /// A mode is unstable when its divergence rate DvR = Re/Im exceeds this.
+    #[arg(long, default_value = "1e-6")]
+    dvr_tol: f64,
+    /// Full-order reference solver.
+    #[arg(long, default_value = "arpack")]
+    reference: String,
+    /// Tolerance of the reference.
+    #[arg(long, default_value = "1e-12")]
+    reference_tol: f64,
+    /// Run the stress set (cases built to break methods) instead of the mu list.
+    #[arg(long)]
+    stress: bool,
+    /// Only redraw the charts (and the stress table) from the `bench.json` or
+    /// `stress.json` already in `--out`, without solving anything.
+    #[arg(long)]
+    replot: bool,
+    #[command(flatten)]
+    contact: crate::opts::ContactArgs,
+    /// Output directory.
+    #[arg(long, default_value = "out/bench")]
+    out: PathBuf,
+}
+
+impl BenchArgs {
+    /// Runs the bench (every option checked first).
+    pub fn run(&self, registry: &Registry, heap: &'static peak_alloc::PeakAlloc) -> Result<()> {
+        if self.replot {
+            return replot(&self.out, self.stress);
+        }
+        if let Some(p) = &self.param {
+            crate::opts::parse_param(p)?;
+            if self.operator.is_none() {
+                anyhow::bail!(
+                    "--param {p}: needs --operator DIR (a parametric operator directory), not a scene"
+                );
+            }
+        }
+        let mut opts = BenchOptions::all(registry);
+        if !self.bases.is_empty() {
+            opts.bases = self.bases.clone();
+        }
+        if !self.eigens.is_empty() {
+            opts.eigens = self.eigens.clone();
+        }
+        for name in opts.bases.iter().filter(|b| *b != "none") {
+            registry
+                .bases
+                .create(name, &squeal_core::Params::new())
+                .map_err(|e| anyhow::anyhow!("--bases {name}: {e}"))?;
+        }
+        for name in &opts.eigens {
+            registry
+                .eigen
+                .create(name, &squeal_core::Params::new())
+                .map_err(|e| anyhow::anyhow!("--eigens {name}: {e}"))?;
+        }
+        registry
+            .eigen
+            .create(&self.reference, &squeal_core::Params::new())
+            .map_err(|e| anyhow::anyhow!("--reference {}: {e}", self.reference))?;
+        self.contact.check(registry)?;
+        opts.vary = parse_vary(&self.vary)?;
+        crate::opts::check_tol("--tol", self.tol)?;
+        crate::opts::check_tol("--reference-tol", self.reference_tol)?;
+        if !(self.dvr_tol.is_finite() && self.dvr_tol >= 0.0) {
+            anyhow::bail!("--dvr-tol {}: expected a number >= 0", self.dvr_tol);
+        }
+        for &mu in &self.mu {
+            crate::opts::check_mu("--mu", mu)?;
+        }
+        let band = self
+            .band
+            .as_deref()
+            .map(crate::opts::parse_band)
+            .transpose()?;
+        opts.tol = self.tol;
+        opts.dvr_tol = self.dvr_tol;
+        opts.reference_eigen = self.reference.clone();
+        opts.reference_tol = self.reference_tol;
+        opts.condition = self.condition;
+        let probe = HeapProbe(heap);
+        run(
+            registry,
+            &Args {
+                scene: self.scene.as_deref(),
+                operator: self.operator.as_deref(),
+                param: self.param.as_deref(),
+                mus: &self.mu,
+                out: &self.out,
+                opts,
+                band,
+                equilibrium: &self.contact.equilibrium,
+                law: &self.contact.law,
+                stress: self.stress,
+            },
+            Some(&probe),
+        )
+    }
+}
+
 /// Inputs of `squeal bench`.
 pub struct Args<'a> {
     pub scene: Option<&'a str>,
     pub operator: Option<&'a Path>,
+    /// `--param NAME=VALUE` of a parametric operator directory, as given.
+    pub param: Option<&'a str>,
     pub mus: &'a [f64],
     pub out: &'a Path,
     pub opts: BenchOptions,
+    /// `None`: the scene's `study.band_hz` (operator files: the default band).
+    pub band: Option<[f64; 2]>,
     pub equilibrium: &'a str,
     pub law: &'a str,
     pub stress: bool,
@@ -47,9 +189,10 @@ struct Summary<'a> {
     units: &'static str,
     band_hz: [f64; 2],
     tol: f64,
+    condition: bool,
     reference_eigen: &'a str,
     reference_tol: f64,
-    unstable_tol: f64,
+    dvr_tol: f64,
     accuracy: squeal_analysis::bench::Accuracy,
     bases: &'a [String],
     eigens: &'a [String],
@@ -168,7 +311,7 @@ fn print_run(r: &BenchRun) {
     println!(
         "  {:<26} n={:<6} setup {:>7.2} s  solve {:>7.2} s{split}  df/f {:>8.1e}  \
          dDvR {:>8.1e}  missed {} modes, {} unstable; false unstable {}  bwd {:>8.1e}  \
-         x{:.1}{}",
+         bound {:>8}  {}{}",
         format!("{}/{}{opts}", r.basis, r.eigen),
         if r.basis_size == 0 {
             r.dofs
@@ -183,9 +326,24 @@ fn print_run(r: &BenchRun) {
         r.errors.missed_unstable,
         r.errors.false_unstable,
         r.errors.max_backward_error,
-        r.solve_speedup,
+        crate::stability::sci(r.errors.max_error_bound),
+        times(r.solve_speedup),
         if r.accurate { "" } else { "  (not accurate)" }
     );
+}
+
+/// A speed ratio with two significant digits: `x64`, `x2.5`, `x0.042`.
+fn times(x: f64) -> String {
+    if !x.is_finite() || x <= 0.0 {
+        "-".into()
+    } else if x >= 10.0 {
+        format!("x{x:.0}")
+    } else if x >= 1.0 {
+        format!("x{x:.1}")
+    } else {
+        let digits = (1 - x.log10().floor() as i32).max(1) as usize;
+        format!("x{x:.digits$}")
+    }
 }
 
 struct Source {
@@ -253,34 +411,54 @@ type BenchCase<'a> = (String, String, f64, Option<Zone>, Option<(&'a str, f64)>)
 
 pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -> Result<()> {
     let start = Instant::now();
-    std::fs::create_dir_all(a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    // an operator directory is read (and checked) before anything is written
+    let operator = match a.operator {
+        Some(dir) => {
+            if a.scene.is_some() {
+                anyhow::bail!("give either a scene or --operator DIR, not both");
+            }
+            if a.stress {
+                anyhow::bail!(
+                    "--stress changes the contact zone and mu: it needs a scene, not --operator"
+                );
+            }
+            Some(Source {
+                name: match a.param {
+                    Some(p) => format!("{} at {p}", dir.display()),
+                    None => dir.display().to_string(),
+                },
+                prep: None,
+                op: Some(crate::opts::read_operator_at(dir, a.param)?),
+            })
+        }
+        None => None,
+    };
+    crate::opts::claim_out(a.out, "bench")?;
     let partial = a.out.join("bench.partial.jsonl");
     let _ = std::fs::remove_file(&partial);
-    let mut src = if let Some(dir) = a.operator {
-        if a.scene.is_some() {
-            anyhow::bail!("give either a scene or --operator DIR, not both");
-        }
-        if a.stress {
-            anyhow::bail!(
-                "--stress changes the contact zone and mu: it needs a scene, not --operator"
-            );
-        }
-        Source {
-            name: dir.display().to_string(),
-            prep: None,
-            op: Some(crate::stability::read_operator_any(dir)?),
-        }
-    } else {
-        let (scene, file) = crate::load_scene(a.scene)?;
-        let prep = Prepared::new(registry, scene, &file)?;
-        Source {
-            name: file,
-            prep: Some(prep),
-            op: None,
+    let mut src = match operator {
+        Some(src) => src,
+        None => {
+            let (scene, file) = crate::opts::load_scene(a.scene)?;
+            let prep = Prepared::new(registry, scene, &file)?;
+            Source {
+                name: file,
+                prep: Some(prep),
+                op: None,
+            }
         }
     };
     for &mu in a.mus {
         squeal_contact::check_user_mu(mu)?;
+    }
+    // the band: given, or the scene's (operator files: the default)
+    let mut base_opts = a.opts.clone();
+    base_opts.band_hz = a.band.unwrap_or(match &src.prep {
+        Some(prep) => prep.scene.study.band_hz,
+        None => crate::opts::OPERATOR_BAND_HZ,
+    });
+    if let Some(prep) = &src.prep {
+        crate::opts::check_band_against(base_opts.band_hz, &prep.scene)?;
     }
     let cases: Vec<BenchCase<'_>> = if a.stress {
         stress_cases()
@@ -302,7 +480,7 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
                 &Zone::Uniform,
                 prep.scene.study.rotation,
             )?;
-            squeal_analysis::bench::free_interface_for(registry, &a.opts, &prep.model, &all)?
+            squeal_analysis::bench::free_interface_for(registry, &base_opts, &prep.model, &all)?
         }
         None => None,
     };
@@ -320,7 +498,7 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
             dofs: op.dim(),
             operator_time_s: op_time,
         });
-        let mut opts = a.opts.clone();
+        let mut opts = base_opts.clone();
         if let Some((k, v)) = vary {
             opts.vary = vec![(k.to_string(), vec![*v])];
             opts.defaults = false;
@@ -361,14 +539,15 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
         version: env!("CARGO_PKG_VERSION"),
         units: "times in s, memory in MB (heap above the run's start), frequencies in Hz; \
                 errors relative (frequency) or absolute (DvR = Re/Im)",
-        band_hz: a.opts.band_hz,
-        tol: a.opts.tol,
-        reference_eigen: &a.opts.reference_eigen,
-        reference_tol: a.opts.reference_tol,
-        unstable_tol: a.opts.unstable_tol,
-        accuracy: a.opts.accuracy,
-        bases: &a.opts.bases,
-        eigens: &a.opts.eigens,
+        band_hz: base_opts.band_hz,
+        tol: base_opts.tol,
+        condition: base_opts.condition,
+        reference_eigen: &base_opts.reference_eigen,
+        reference_tol: base_opts.reference_tol,
+        dvr_tol: base_opts.dvr_tol,
+        accuracy: base_opts.accuracy,
+        bases: &base_opts.bases,
+        eigens: &base_opts.eigens,
         vary: a
             .opts
             .vary
@@ -389,8 +568,12 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
         println!("\nspeed-up over the reference at equal accuracy (fastest accurate run):");
         for r in &ratios {
             println!(
-                "  {:<8} {:<22} {:<20} total x{:<8.1} per mu x{:.1}",
-                r.case, r.method, r.basis_opts, r.speedup, r.solve_speedup
+                "  {:<8} {:<22} {:<20} total {:<9} per mu {}",
+                r.case,
+                r.method,
+                r.basis_opts,
+                times(r.speedup),
+                times(r.solve_speedup)
             );
         }
     }
@@ -541,8 +724,13 @@ fn charts(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
     Ok(files)
 }
 
-/// The stress table: per case and method, whether it is wrong and how its own error
-/// estimate (the worst backward error) moved against the baseline case.
+/// The stress table: per case and method, whether it is wrong; whether its own error
+/// estimate (the worst backward error) rose against the baseline case; its worst
+/// condition number and forward error estimate (`error_bound`), and, where it is wrong,
+/// whether that bound flagged it: the bound covers every matched mode's actual eigenvalue
+/// error and no mode was missed, or the bound exceeds the accuracy threshold
+/// ([`bound_threshold`]). Printed, and written to `stress-table.txt` and
+/// `stress-table.json`.
 fn stress_report(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
     #[derive(Serialize)]
     struct Row {
@@ -555,10 +743,22 @@ fn stress_report(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
         baseline_backward_error: f64,
         estimate_ratio: f64,
         flagged: bool,
+        /// Worst condition number of the case's modes (null: not computed).
+        cond: f64,
+        /// Worst forward error estimate of the case's modes (null: not computed).
+        error_bound: f64,
+        /// The actual worst relative eigenvalue error of the matched modes.
+        actual_error: f64,
+        /// Matched modes whose actual error exceeds their own bound.
+        above_bound: usize,
+        /// For a wrong run with bounds: whether the bound flagged it (null otherwise).
+        bound_flagged: Option<bool>,
         /// The method stopped with an error (e.g. `dense` refusing a full-order problem
         /// above its `max_dim`): no answer, so neither right nor wrong.
         failed: bool,
     }
+    let acc = squeal_analysis::bench::Accuracy::default();
+    let threshold = bound_threshold(&acc);
     let base = |r: &BenchRun| -> f64 {
         runs.iter()
             .find(|b| b.case == "baseline" && b.basis == r.basis && b.eigen == r.eigen)
@@ -566,7 +766,6 @@ fn stress_report(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
     };
     let mut rows = Vec::new();
     for r in runs.iter().filter(|r| !r.reference) {
-        let acc = squeal_analysis::bench::Accuracy::default();
         let mut why = Vec::new();
         if r.status != "ok" {
             why.push(r.status.clone());
@@ -590,27 +789,50 @@ fn stress_report(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
         }
         let b = base(r);
         let ratio = r.errors.max_backward_error / b;
+        let wrong = r.status == "ok" && !why.is_empty();
+        let e = &r.errors;
         rows.push(Row {
             case: r.case.clone(),
             method: format!("{}/{}", r.basis, r.eigen),
             basis_opts: r.basis_opts.clone(),
-            wrong: r.status == "ok" && !why.is_empty(),
+            wrong,
             failed: r.status != "ok",
             why,
-            max_backward_error: r.errors.max_backward_error,
+            max_backward_error: e.max_backward_error,
             baseline_backward_error: b,
             estimate_ratio: ratio,
             flagged: ratio >= 10.0,
+            cond: e.max_cond,
+            error_bound: e.max_error_bound,
+            actual_error: e.max_rel_lambda_err,
+            above_bound: e.above_bound,
+            bound_flagged: (wrong && !e.max_error_bound.is_nan())
+                .then(|| bound_flags(e, threshold)),
         });
     }
-    println!("\nstress set: where each method is wrong, and whether its backward error rose >= 10x over the baseline case");
-    println!(
-        "  {:<10} {:<28} {:<6} {:>10} {:>9} {:<7} why",
-        "case", "method", "wrong", "bwd err", "x base", "flagged"
+    let mut text = format!(
+        "stress set: where each method is wrong; whether its backward error rose >= 10x over \
+         the baseline case (flagged); its worst cond and error_bound (relative eigenvalue \
+         error estimate) against the actual worst relative eigenvalue error; for a WRONG run, \
+         whether the bound flagged it (it covers every matched mode's error with no mode \
+         missed, or exceeds {threshold:.0e})\n"
     );
+    text.push_str(&format!(
+        "  {:<10} {:<36} {:<6} {:>10} {:>9} {:<7} {:>9} {:>9} {:>9} {:<7} why\n",
+        "case",
+        "method",
+        "wrong",
+        "bwd err",
+        "x base",
+        "flagged",
+        "cond",
+        "bound",
+        "actual",
+        "bound?"
+    ));
     for r in &rows {
-        println!(
-            "  {:<10} {:<28} {:<6} {:>10.1e} {:>9.1} {:<7} {}",
+        text.push_str(&format!(
+            "  {:<10} {:<36} {:<6} {:>10.1e} {:>9.1} {:<7} {:>9} {:>9} {:>9} {:<7} {}\n",
             r.case,
             format!(
                 "{}{}",
@@ -631,13 +853,69 @@ fn stress_report(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
             r.max_backward_error,
             r.estimate_ratio,
             if r.flagged { "yes" } else { "no" },
+            crate::stability::sci(r.cond),
+            crate::stability::sci(r.error_bound),
+            crate::stability::sci(r.actual_error),
+            match r.bound_flagged {
+                Some(true) => "yes",
+                Some(false) => "NO",
+                None => "-",
+            },
             r.why.join("; ")
-        );
+        ));
     }
+    let wrong = rows.iter().filter(|r| r.wrong).count();
+    let flagged = rows
+        .iter()
+        .filter(|r| r.bound_flagged == Some(true))
+        .count();
+    let unbounded = rows
+        .iter()
+        .filter(|r| r.wrong && r.bound_flagged.is_none())
+        .count();
+    let accurate: Vec<&Row> = rows.iter().filter(|r| !r.wrong && !r.failed).collect();
+    let alarms = accurate
+        .iter()
+        .filter(|r| r.error_bound > threshold)
+        .count();
+    text.push_str(&format!(
+        "wrong runs: {wrong}, flagged by their bound: {flagged}{}; accurate runs whose bound \
+         exceeds {threshold:.0e} (false alarms): {alarms} of {}; matched modes above their \
+         own bound: {}\n",
+        if unbounded > 0 {
+            format!(" ({unbounded} without bounds: full order above 1000 DOFs, see --condition)")
+        } else {
+            String::new()
+        },
+        accurate.len(),
+        rows.iter().map(|r| r.above_bound).sum::<usize>()
+    ));
+    println!("\n{text}");
+    let txt = out.join("stress-table.txt");
+    std::fs::write(&txt, &text).with_context(|| format!("writing {}", txt.display()))?;
     let path = out.join("stress-table.json");
     std::fs::write(&path, serde_json::to_string_pretty(&rows)?)
         .with_context(|| format!("writing {}", path.display()))?;
-    Ok(vec![path])
+    Ok(vec![txt, path])
+}
+
+/// The forward error estimate above which a run cannot be trusted to be accurate: a
+/// relative eigenvalue error `e` moves the frequency by up to about `e` (relative) and
+/// the DvR by up to about `e` (absolute), so the smaller of the two accuracy bounds.
+pub fn bound_threshold(acc: &squeal_analysis::bench::Accuracy) -> f64 {
+    acc.freq_rel.min(acc.dvr_abs)
+}
+
+/// Whether a run's bounds flag its errors: every reference mode found, no extra mode
+/// (a bound cannot vouch for a mode it does not have, nor against a spurious one) and
+/// every matched mode's actual error within its own bound; or the worst bound above
+/// `threshold`.
+pub fn bound_flags(e: &squeal_analysis::bench::ModeErrors, threshold: f64) -> bool {
+    let covers = e.missed_modes == 0
+        && e.extra_modes == 0
+        && e.above_bound == 0
+        && e.max_error_bound.is_finite();
+    covers || e.max_error_bound > threshold
 }
 
 /// Parses `--vary key=v1,v2` options (`none` for no variant).

@@ -3,13 +3,11 @@
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use squeal_contact::{problem, reference_load, solve_on, ContactSet, LoadedEquilibrium};
-use squeal_core::contact::Condensation;
+use squeal_analysis::pipeline::Prepared;
+use squeal_contact::{ContactSet, LoadedEquilibrium};
 use squeal_core::{Params, Registry};
-use squeal_scene::{build, BodyKind, Scene};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// One equilibrium as written to `equilibrium.json`.
 #[derive(Serialize, Clone)]
@@ -36,66 +34,6 @@ pub struct EquilibriumReport {
     pub condensation_time_s: f64,
     pub time_s: f64,
     pub csv: String,
-}
-
-/// Everything needed to solve equilibria of one scene for several mu.
-pub struct Setup {
-    pub scene: Scene,
-    pub file: String,
-    pub model: squeal_scene::Model,
-    pub set: ContactSet,
-    pub build_time_s: f64,
-}
-
-impl Setup {
-    pub fn new(registry: &Registry, scene_arg: Option<&str>) -> Result<Self> {
-        let start = Instant::now();
-        let (scene, file) = crate::load_scene(scene_arg)?;
-        let model = build(&scene, BodyKind::All, registry, &file)?;
-        let set = ContactSet::new(&model, &scene.contact.zone, scene.study.rotation)
-            .with_context(|| format!("contact pairs of {file}"))?;
-        Ok(Self {
-            scene,
-            file,
-            model,
-            set,
-            build_time_s: start.elapsed().as_secs_f64(),
-        })
-    }
-
-    /// Solves for every mu with one condensation.
-    pub fn solve(
-        &self,
-        registry: &Registry,
-        solver: &str,
-        law: &str,
-        law_params: &Params,
-        mus: &[f64],
-    ) -> Result<(Vec<LoadedEquilibrium>, f64)> {
-        let solver_obj = registry.equilibrium.create(solver, &Params::new())?;
-        let law_obj = registry.contact_laws.create(law, law_params)?;
-        for &mu in mus {
-            squeal_contact::check_user_mu(mu)?;
-        }
-        let (f, g0) = reference_load(&self.model, &self.set);
-        let prob = problem(&self.model, &self.set, &f, &g0);
-        let cond = Condensation::new(&prob).context("condensation on the contact pairs")?;
-        let mut out = Vec::new();
-        for &mu in mus {
-            let eq = solve_on(
-                &cond,
-                &prob,
-                &self.set,
-                &self.scene.load,
-                solver_obj.as_ref(),
-                law_obj.as_ref(),
-                mu,
-            )
-            .with_context(|| format!("equilibrium at mu = {mu} with `{solver}`"))?;
-            out.push(eq);
-        }
-        Ok((out, cond.time_s))
-    }
 }
 
 pub fn leading_edge(rotation: f64) -> String {
@@ -125,35 +63,142 @@ pub fn write_csv(path: &Path, set: &ContactSet, eq: &LoadedEquilibrium) -> Resul
     Ok(())
 }
 
-#[allow(clippy::too_many_arguments)]
+/// `squeal equilibrium`.
+#[derive(clap::Args)]
+pub struct EquilibriumArgs {
+    #[command(flatten)]
+    scene: crate::opts::SceneArg,
+    /// Friction coefficient(s), comma separated (default: the scene's study.mu).
+    #[arg(long, value_delimiter = ',')]
+    mu: Vec<f64>,
+    /// Equilibrium solver plugin (`lorang`, `lcp`).
+    #[arg(long, default_value = "lcp")]
+    equilibrium: String,
+    /// Contact law plugin (`lagrange`, `penalty`).
+    #[arg(long, default_value = "lagrange")]
+    law: String,
+    /// Contact law parameters, `key=value` (e.g. `kn_n_per_m=1e10`).
+    #[arg(long = "law-opt")]
+    law_opt: Vec<String>,
+    /// Output directory.
+    #[arg(long, default_value = "out/equilibrium")]
+    out: PathBuf,
+}
+
+impl EquilibriumArgs {
+    /// Solves, writes and prints the equilibria.
+    pub fn run(&self, registry: &Registry) -> Result<()> {
+        let law_params = crate::opts::parse_params(&self.law_opt)?;
+        for &mu in &self.mu {
+            crate::opts::check_mu("--mu", mu)?;
+        }
+        registry
+            .equilibrium
+            .create(&self.equilibrium, &Params::new())
+            .context("--equilibrium")?;
+        registry
+            .contact_laws
+            .create(&self.law, &law_params)
+            .context("--law/--law-opt")?;
+        let reports = run(
+            registry,
+            &self.scene,
+            &self.mu,
+            &self.equilibrium,
+            &self.law,
+            &law_params,
+            &self.out,
+        )?;
+        println!(
+            "{:>6} {:>10} {:>10} {:>7} {:>6} {:>10} {:>10} {:>13} {:>8}",
+            "mu",
+            "Fn (N)",
+            "Ft (N)",
+            "active",
+            "iter",
+            "residual",
+            "compl.",
+            "centroid x mm",
+            "time s"
+        );
+        for r in &reports {
+            println!(
+                "{:>6.3} {:>10.4} {:>10.4} {:>7} {:>6} {:>10.2e} {:>10.2e} {:>13.4} {:>8.3}",
+                r.mu,
+                r.total_normal_force_n,
+                r.total_tangential_force_n,
+                r.active_pairs,
+                r.iterations,
+                r.residual,
+                r.complementarity_residual,
+                r.centroid_m[0] * 1e3,
+                r.time_s
+            );
+        }
+        if let Some(r) = reports.first() {
+            println!("leading edge {}", r.leading_edge);
+        }
+        for p in outputs(&self.out, &reports) {
+            println!("wrote {}", p.display());
+        }
+        Ok(())
+    }
+}
+
+/// Solves the equilibria of `scene` at `mus` (the scene's study.mu when empty), writes
+/// equilibrium.json, one CSV per mu and the contact force map into `out`.
 pub fn run(
     registry: &Registry,
-    scene_arg: Option<&str>,
+    scene: &crate::opts::SceneArg,
     mus: &[f64],
     solver: &str,
     law: &str,
     law_params: &Params,
     out: &Path,
 ) -> Result<Vec<EquilibriumReport>> {
-    let start = Instant::now();
-    if mus.is_empty() {
-        anyhow::bail!("--mu: give at least one friction coefficient");
+    let (scene, file) = scene.load()?;
+    let mus = if mus.is_empty() {
+        vec![scene.study.mu]
+    } else {
+        mus.to_vec()
+    };
+    let prep = Prepared::new(registry, scene, &file)?;
+    crate::opts::claim_out(out, "equilibrium")?;
+    run_on(registry, &prep, &mus, solver, law, law_params, out)
+}
+
+/// The equilibria of a prepared scene at `mus`, written into `out` (shared with
+/// `validate`).
+pub fn run_on(
+    registry: &Registry,
+    prep: &Prepared,
+    mus: &[f64],
+    solver: &str,
+    law: &str,
+    law_params: &Params,
+    out: &Path,
+) -> Result<Vec<EquilibriumReport>> {
+    let mut eqs = Vec::new();
+    for &mu in mus {
+        eqs.push(
+            prep.equilibrium_with(registry, solver, law, law_params, mu)
+                .with_context(|| format!("equilibrium at mu = {mu} with `{solver}`"))?,
+        );
     }
-    let setup = Setup::new(registry, scene_arg)?;
-    let (eqs, cond_time) = setup.solve(registry, solver, law, law_params, mus)?;
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let cond_time = prep.condensation.time_s;
+    crate::opts::prepare_out(out)?;
     let mut reports = Vec::new();
-    let c = setup.set.len() / 2;
-    let dir = setup.set.direction[c];
+    let c = prep.set.len() / 2;
+    let dir = prep.set.direction[c];
     for eq in &eqs {
         let csv = if eqs.len() == 1 {
             "pairs.csv".to_string()
         } else {
             format!("pairs_mu{:.3}.csv", eq.eq.mu)
         };
-        write_csv(&out.join(&csv), &setup.set, eq)?;
+        write_csv(&out.join(&csv), &prep.set, eq)?;
         reports.push(EquilibriumReport {
-            scene: setup.file.clone(),
+            scene: prep.file.clone(),
             units: "SI: forces in N, lengths in m, times in s",
             solver: solver.into(),
             law: law.into(),
@@ -163,15 +208,15 @@ pub fn run(
             tangential_resultant_n: eq.tangential_resultant_n,
             disc_displacement_m: eq.displacement_m,
             active_pairs: eq.eq.active.iter().filter(|&&a| a).count(),
-            pairs: setup.set.len(),
+            pairs: prep.set.len(),
             iterations: eq.eq.iterations,
             factorizations: 1,
             residual: eq.eq.equilibrium_residual,
             complementarity_residual: eq.eq.complementarity_residual,
             centroid_m: eq.centroid_m,
             sliding_direction: [dir[0], dir[1]],
-            leading_edge: leading_edge(setup.set.rotation),
-            build_time_s: setup.build_time_s,
+            leading_edge: leading_edge(prep.set.rotation),
+            build_time_s: prep.build_time_s,
             condensation_time_s: cond_time,
             time_s: eq.eq.time_s,
             csv,
@@ -184,19 +229,14 @@ pub fn run(
     };
     let path = out.join("equilibrium.json");
     std::fs::write(&path, json).with_context(|| format!("writing {}", path.display()))?;
-    let grid = setup
+    let grid = prep
         .model
         .contact
         .as_ref()
         .expect("a contact set has a grid");
     let cell = [grid.xs[1] - grid.xs[0], grid.ys[1] - grid.ys[0]];
     let grid_cells = grid.cells();
-    let cells: Vec<[f64; 4]> = setup
-        .set
-        .grid_index
-        .iter()
-        .map(|&g| grid_cells[g])
-        .collect();
+    let cells: Vec<[f64; 4]> = prep.set.grid_index.iter().map(|&g| grid_cells[g]).collect();
     let panels: Vec<squeal_plot::MapPanel> = eqs
         .iter()
         .map(|eq| squeal_plot::MapPanel {
@@ -204,9 +244,9 @@ pub fn run(
                 "mu = {} ({} of {} pairs)",
                 eq.eq.mu,
                 eq.eq.active.iter().filter(|&&a| a).count(),
-                setup.set.len()
+                prep.set.len()
             ),
-            xy: setup.set.xy.clone(),
+            xy: prep.set.xy.clone(),
             values: eq.eq.rn.clone(),
             cell,
             cells: cells.clone(),
@@ -218,8 +258,7 @@ pub fn run(
         &out.join("contact_map"),
         &format!(
             "Normal contact force per pair, {} N total ({solver}, {law})",
-            setup
-                .scene
+            prep.scene
                 .load
                 .normal_force_n
                 .map_or("imposed-displacement".to_string(), |f| format!("{f}"))
@@ -228,7 +267,6 @@ pub fn run(
         &panels,
     )
     .context("contact force map")?;
-    let _ = start;
     Ok(reports)
 }
 

@@ -5,7 +5,69 @@ use serde::Serialize;
 use squeal_analysis::modal::{normal_modes, ModeRecord};
 use squeal_core::{EigenParams, Params, Registry};
 use squeal_scene::{build, BodyKind};
+use std::path::PathBuf;
 use std::time::Instant;
+
+/// Bodies of a scene.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum Body {
+    /// The disc.
+    Disc,
+    /// The pin with its plates.
+    Pin,
+    /// Every body.
+    All,
+}
+
+/// `squeal modes`.
+#[derive(clap::Args)]
+pub struct ModesArgs {
+    #[command(flatten)]
+    scene: crate::opts::SceneArg,
+    /// Which bodies.
+    #[arg(long, value_enum, default_value = "all")]
+    body: Body,
+    /// Band top (Hz).
+    #[arg(long, default_value_t = 10_500.0)]
+    max_freq: f64,
+    /// Eigen solver plugin.
+    #[arg(long, default_value = "arpack")]
+    eigen: String,
+    /// Relative tolerance of the eigen solver.
+    #[arg(long, default_value = "1e-10")]
+    tol: f64,
+    /// Write the modes as JSON here.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Write the mesh and mode shapes for ParaView here (VTU files + modes.pvd).
+    #[arg(long)]
+    vtu: Option<PathBuf>,
+}
+
+impl ModesArgs {
+    /// Solves, prints and writes what was asked.
+    pub fn run(&self, registry: &Registry) -> Result<()> {
+        let which = match self.body {
+            Body::Disc => BodyKind::Disc,
+            Body::Pin => BodyKind::Pin,
+            Body::All => BodyKind::All,
+        };
+        let report = run(
+            registry,
+            self.scene.as_deref(),
+            which,
+            self.max_freq,
+            &self.eigen,
+            self.tol,
+            self.vtu.as_deref(),
+        )?;
+        print!("{}", format(&report));
+        if let Some(path) = &self.json {
+            write_json(&report, path)?;
+        }
+        Ok(())
+    }
+}
 
 /// What `squeal modes --json` writes.
 #[derive(Serialize)]
@@ -34,9 +96,25 @@ pub fn run(
     tol: f64,
     vtu: Option<&std::path::Path>,
 ) -> Result<ModesReport> {
+    let (scene, file) = crate::opts::load_scene(scene)?;
+    run_scene(registry, &scene, &file, which, max_freq, eigen, tol, vtu)
+}
+
+/// [`run`] on a scene already read (`file` names it).
+#[allow(clippy::too_many_arguments)]
+pub fn run_scene(
+    registry: &Registry,
+    scene: &squeal_scene::Scene,
+    file: &str,
+    which: BodyKind,
+    max_freq: f64,
+    eigen: &str,
+    tol: f64,
+    vtu: Option<&std::path::Path>,
+) -> Result<ModesReport> {
     let start = Instant::now();
-    let (scene, file) = crate::load_scene(scene)?;
-    let model = build(&scene, which, registry, &file)?;
+    let file = file.to_string();
+    let model = build(scene, which, registry, &file)?;
     let solver = registry.eigen.create(eigen, &Params::new())?;
     let params = EigenParams {
         fmax_hz: max_freq,

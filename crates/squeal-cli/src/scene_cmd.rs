@@ -2,7 +2,63 @@
 
 use anyhow::Result;
 use squeal_core::Registry;
-use squeal_scene::{build, BodyKind, Scene};
+use squeal_scene::{build, BodyKind, Scene, BUILTIN_SCENES};
+
+/// `squeal scene`.
+#[derive(clap::Subcommand)]
+pub enum SceneCmd {
+    /// The embedded scenes: size (built now) and what each is for.
+    List,
+    /// DOFs per body, contact pairs, element sizes and quality, and the size rule.
+    Info {
+        #[command(flatten)]
+        scene: crate::opts::SceneArg,
+    },
+    /// Prints the scene as the program reads it (TOML, every default filled in).
+    Show {
+        #[command(flatten)]
+        scene: crate::opts::SceneArg,
+    },
+}
+
+impl SceneCmd {
+    /// Runs the action.
+    pub fn run(&self, registry: &Registry) -> Result<()> {
+        match self {
+            SceneCmd::List => list(registry),
+            SceneCmd::Info { scene } => {
+                let (scene, file) = scene.load()?;
+                info(registry, &scene, &file)
+            }
+            SceneCmd::Show { scene } => {
+                let (scene, _) = scene.load()?;
+                print!("{}", scene.to_toml());
+                Ok(())
+            }
+        }
+    }
+}
+
+/// Prints the embedded scenes with their size, counted by building each.
+fn list(registry: &Registry) -> Result<()> {
+    println!("{:<22} {:>9} {:>7}  what it is", "scene", "DOFs", "pairs");
+    for name in BUILTIN_SCENES {
+        let scene = Scene::builtin(name)?;
+        let model = build(&scene, BodyKind::All, registry, name)?;
+        println!(
+            "{:<22} {:>9} {:>7}  {}",
+            name,
+            model.dofs.n_free(),
+            model.contact.as_ref().map_or(0, |c| c.len()),
+            scene.description
+        );
+    }
+    println!(
+        "\nUse a name as SCENE (`squeal stability pin-on-disc-coarse`), or a scene file; \
+         `squeal scene show NAME` prints one to start a file from."
+    );
+    Ok(())
+}
 
 /// Builds the whole scene and prints DOFs per body, contact pairs, element sizes, mesh
 /// quality and the rule that chose the sizes.

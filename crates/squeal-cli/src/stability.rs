@@ -17,12 +17,20 @@ pub struct ModeOut {
     pub dvr: f64,
     pub unstable: bool,
     pub backward_error: f64,
+    /// Condition number of the eigenvalue (null when not computed: full order above 1000
+    /// DOFs without --condition).
+    pub cond: f64,
+    /// First-order estimate of the relative eigenvalue error, `cond * backward_error`
+    /// (null when not computed).
+    pub error_bound: f64,
 }
 
 /// What `squeal stability --json` writes.
 #[derive(Serialize)]
 pub struct StabilityReport {
     pub source: String,
+    /// The parameter value of a parametric operator (`--param`, e.g. `W=5`).
+    pub param: Option<String>,
     pub units: &'static str,
     pub dofs: usize,
     pub full_dofs: usize,
@@ -33,7 +41,7 @@ pub struct StabilityReport {
     pub basis_time_s: f64,
     pub band_hz: [f64; 2],
     pub tol: f64,
-    pub unstable_tol: f64,
+    pub dvr_tol: f64,
     pub active_pairs: Option<usize>,
     pub pairs: Option<usize>,
     /// The scene's damping (`none`, or its Rayleigh coefficients and contact dashpots), or
@@ -48,18 +56,130 @@ pub struct StabilityReport {
     pub factorizations: usize,
     pub notes: Vec<String>,
     pub max_backward_error: f64,
+    /// Worst `error_bound` of the modes (null when not computed).
+    pub max_error_bound: f64,
     pub modes: Vec<ModeOut>,
+}
+
+/// `squeal stability`.
+#[derive(clap::Args)]
+pub struct StabilityArgs {
+    #[command(flatten)]
+    scene: crate::opts::SceneArg,
+    /// Operator directory (Mc.mtx, Kc.mtx, ... as written by `squeal export`) instead of
+    /// a scene.
+    #[arg(long)]
+    operator: Option<std::path::PathBuf>,
+    /// The parameter of a parametric operator directory (--operator), `NAME=VALUE` with
+    /// the name its operator.toml declares, e.g. `W=5`.
+    #[arg(long, value_name = "NAME=VALUE")]
+    param: Option<String>,
+    /// Friction coefficient (default: the scene's study.mu; required with --operator).
+    #[arg(long)]
+    mu: Option<f64>,
+    #[command(flatten)]
+    method: crate::opts::MethodArgs,
+    /// Condition numbers and forward error estimates for every mode, also at full order
+    /// above 1000 DOFs where the solvers skip them (one extra factorization per mode).
+    #[arg(long)]
+    condition: bool,
+    #[command(flatten)]
+    contact: crate::opts::ContactArgs,
+    /// Write the result as JSON here.
+    #[arg(long)]
+    json: Option<std::path::PathBuf>,
+}
+
+impl StabilityArgs {
+    /// Solves, prints and writes the JSON.
+    pub fn run(&self, registry: &Registry) -> Result<()> {
+        self.method.check(registry)?;
+        self.contact.check(registry)?;
+        if let Some(mu) = self.mu {
+            crate::opts::check_mu("--mu", mu)?;
+        }
+        if let Some(p) = &self.param {
+            crate::opts::parse_param(p)?;
+            if self.operator.is_none() {
+                anyhow::bail!(
+                    "--param {p}: needs --operator DIR (a parametric operator directory), not a scene"
+                );
+            }
+        }
+        let eigen = self.method.eigen();
+        let basis_opts = self.method.basis_opt.clone();
+        let args = Args {
+            scene: self.scene.as_deref(),
+            operator: self.operator.as_deref(),
+            param: self.param.as_deref(),
+            condition: self.condition,
+            mu: self.mu,
+            basis: &self.method.basis,
+            basis_opts: &basis_opts,
+            eigen: &eigen,
+            band: self.method.band.clone(),
+            tol: self.method.tol,
+            dvr_tol: self.method.dvr_tol,
+            equilibrium: &self.contact.equilibrium,
+            law: &self.contact.law,
+        };
+        let report = run(registry, &args)?;
+        print(&report);
+        if let Some(path) = &self.json {
+            std::fs::write(path, serde_json::to_string_pretty(&report)?)
+                .with_context(|| format!("--json {}: cannot write", path.display()))?;
+        }
+        Ok(())
+    }
+}
+
+/// `squeal export`.
+#[derive(clap::Args)]
+pub struct ExportArgs {
+    #[command(flatten)]
+    scene: crate::opts::SceneArg,
+    /// Friction coefficient of the equilibrium (default: the scene's study.mu).
+    #[arg(long)]
+    mu: Option<f64>,
+    #[command(flatten)]
+    contact: crate::opts::ContactArgs,
+    /// Output directory.
+    #[arg(long)]
+    out: std::path::PathBuf,
+}
+
+impl ExportArgs {
+    /// Writes both forms of the operator.
+    pub fn run(&self, registry: &Registry) -> Result<()> {
+        self.contact.check(registry)?;
+        if let Some(mu) = self.mu {
+            crate::opts::check_mu("--mu", mu)?;
+        }
+        export(
+            registry,
+            self.scene.as_deref(),
+            self.mu,
+            &self.contact.equilibrium,
+            &self.contact.law,
+            &self.out,
+        )
+    }
 }
 
 /// Inputs of one stability run.
 pub struct Args<'a> {
     pub scene: Option<&'a str>,
     pub operator: Option<&'a Path>,
+    /// `--param NAME=VALUE` of a parametric operator directory, as given.
+    pub param: Option<&'a str>,
+    /// Condition numbers also at full order above the solvers' automatic size.
+    pub condition: bool,
     pub mu: Option<f64>,
     pub eigen: &'a str,
-    pub band: [f64; 2],
+    /// `--band` as given; `None`: the scene's band.
+    pub band: Option<String>,
     pub tol: f64,
-    pub unstable_tol: f64,
+    pub dvr_tol: f64,
     pub equilibrium: &'a str,
     pub law: &'a str,
     pub basis: &'a str,
@@ -76,6 +196,8 @@ pub struct Source {
     pub damping: String,
     pub equilibrium_time_s: f64,
     pub operator_time_s: f64,
+    /// The band of the scene (`study.band_hz`), or the default of operator files.
+    pub band_hz: [f64; 2],
     /// The built scene (none for an operator read from files).
     pub prep: Option<Prepared>,
 }
@@ -86,7 +208,7 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
             anyhow::bail!("give either a scene or --operator DIR, not both");
         }
         let start = Instant::now();
-        let op = read_operator_any(dir)?;
+        let op = crate::opts::read_operator_at(dir, a.param)?;
         let mu = a.mu.context("--mu is required with --operator")?;
         squeal_contact::check_user_mu(mu)?;
         let damping = if op.cc.is_some() || op.fc.is_some() {
@@ -95,7 +217,10 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
             "none".into()
         };
         return Ok(Source {
-            name: dir.display().to_string(),
+            name: match a.param {
+                Some(p) => format!("{} at {p}", dir.display()),
+                None => dir.display().to_string(),
+            },
             op,
             mu,
             active_pairs: None,
@@ -103,10 +228,11 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
             damping,
             equilibrium_time_s: 0.0,
             operator_time_s: start.elapsed().as_secs_f64(),
+            band_hz: crate::opts::OPERATOR_BAND_HZ,
             prep: None,
         });
     }
-    let (scene, file) = crate::load_scene(a.scene)?;
+    let (scene, file) = crate::opts::load_scene(a.scene)?;
     let mu = a.mu.unwrap_or(scene.study.mu);
     let prep = Prepared::new(registry, scene, &file)?;
     let t0 = Instant::now();
@@ -123,6 +249,7 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
         damping: prep.scene.damping.describe(),
         equilibrium_time_s,
         operator_time_s: t1.elapsed().as_secs_f64(),
+        band_hz: prep.scene.study.band_hz,
         prep: Some(prep),
     })
 }
@@ -130,20 +257,28 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
 pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
     let start = Instant::now();
     let src = source(registry, a)?;
+    let band = match &a.band {
+        Some(b) => crate::opts::parse_band(b)?,
+        None => src.band_hz,
+    };
+    if let Some(prep) = &src.prep {
+        crate::opts::check_band_against(band, &prep.scene)?;
+    }
     let params = EigenParams {
-        fmin_hz: a.band[0],
-        fmax_hz: a.band[1],
+        fmin_hz: band[0],
+        fmax_hz: band[1],
         tol: a.tol,
         ..EigenParams::default()
     };
     let mut method = squeal_analysis::pipeline::Method::new(
         registry,
         a.basis,
-        &parse_params(a.basis_opts)?,
+        &crate::opts::parse_params(a.basis_opts)?,
         a.eigen,
         "arpack",
         params,
     )?;
+    method.set_condition(a.condition);
     if let Some(prep) = &src.prep {
         method.prepare_free_interface(&prep.model, &prep.set)?;
     }
@@ -154,12 +289,15 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
             re: modes.lambda[i].re,
             im: modes.lambda[i].im,
             dvr: modes.dvr[i],
-            unstable: modes.is_unstable(i, a.unstable_tol),
+            unstable: modes.is_unstable(i, a.dvr_tol),
             backward_error: modes.backward_error[i],
+            cond: modes.cond[i],
+            error_bound: modes.error_bound[i],
         })
         .collect();
     Ok(StabilityReport {
         source: src.name,
+        param: a.param.map(str::to_string),
         units: "SI: frequencies in Hz, real parts in 1/s, times in s; DvR = Re/Im",
         dofs: src.op.dim(),
         full_dofs: src.op.full_dim(),
@@ -168,9 +306,9 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
         basis: a.basis.into(),
         basis_size,
         basis_time_s,
-        band_hz: a.band,
+        band_hz: band,
         tol: a.tol,
-        unstable_tol: a.unstable_tol,
+        dvr_tol: a.dvr_tol,
         active_pairs: src.active_pairs,
         pairs: src.pairs,
         damping: src.damping,
@@ -183,6 +321,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
         factorizations: modes.info.factorizations,
         notes: modes.info.notes.clone(),
         max_backward_error: modes.backward_error.iter().fold(0.0, |m: f64, &b| m.max(b)),
+        max_error_bound: worst(&modes.error_bound),
         modes: out,
     })
 }
@@ -214,18 +353,25 @@ pub fn print(r: &StabilityReport) {
         println!("damping: {}", r.damping);
     }
     println!(
-        "{:>4} {:>12} {:>14} {:>12} {:>9} {:>10}",
-        "#", "freq (Hz)", "Re (1/s)", "DvR", "unstable", "backward"
+        "{:>4} {:>12} {:>14} {:>12} {:>9} {:>10} {:>10} {:>10}",
+        "#", "freq (Hz)", "Re (1/s)", "DvR", "unstable", "backward", "cond", "err bound"
     );
     for (i, m) in r.modes.iter().enumerate() {
         println!(
-            "{:>4} {:>12.3} {:>14.6e} {:>12.4e} {:>9} {:>10.1e}",
+            "{:>4} {:>12.3} {:>14.6e} {:>12.4e} {:>9} {:>10.1e} {:>10} {:>10}",
             i + 1,
             m.freq_hz,
             m.re,
             m.dvr,
             if m.unstable { "YES" } else { "" },
-            m.backward_error
+            m.backward_error,
+            sci(m.cond),
+            sci(m.error_bound)
+        );
+    }
+    if r.modes.iter().any(|m| m.cond.is_nan()) {
+        println!(
+            "cond, err bound: not computed at full order above 1000 DOFs (--condition computes them)"
         );
     }
     for n in &r.notes {
@@ -233,20 +379,39 @@ pub fn print(r: &StabilityReport) {
     }
 }
 
+/// A number in scientific notation with two digits, `-` when it was not computed (NaN).
+pub fn sci(x: f64) -> String {
+    if x.is_nan() {
+        "-".into()
+    } else {
+        format!("{x:.1e}")
+    }
+}
+
+/// The largest of `values` that are not NaN (NaN when all are, or there are none).
+pub fn worst(values: &[f64]) -> f64 {
+    values
+        .iter()
+        .fold(f64::NAN, |m, &v| if v.is_nan() || m >= v { m } else { v })
+}
+
 /// Reads an operator directory in either form: the constrained parts (`Mc.mtx`, ...),
 /// preferred when present, or the full form (`M.mtx`, `K.mtx`, `pairs.csv`).
 pub fn read_operator_any(dir: &Path) -> Result<FrictionalOperator> {
-    if dir.join(squeal_io::FILE_MC).is_file() {
-        Ok(squeal_io::read_operator_dir(dir)?)
+    let op = if dir.join(squeal_io::FILE_MC).is_file() {
+        squeal_io::read_operator_dir(dir)?
     } else if squeal_contact::files::is_full_form(dir) {
-        Ok(squeal_contact::files::read_full_form(dir)?)
+        squeal_contact::files::read_full_form(dir)?
     } else {
         anyhow::bail!(
             "{}: not an operator directory: expected Mc.mtx and Kc.mtx (constrained form) or \
              M.mtx, K.mtx and pairs.csv (full form), as written by `squeal export`",
             dir.display()
         )
-    }
+    };
+    op.check_pencil()
+        .map_err(|e| anyhow::anyhow!("--operator {}: {e}", dir.display()))?;
+    Ok(op)
 }
 
 /// `squeal export`: both forms of a scene's operator at its equilibrium for `mu`.
@@ -258,7 +423,7 @@ pub fn export(
     law: &str,
     out: &Path,
 ) -> Result<()> {
-    let (scene, file) = crate::load_scene(scene)?;
+    let (scene, file) = crate::opts::load_scene(scene)?;
     let mu = mu.unwrap_or(scene.study.mu);
     let prep = Prepared::new(registry, scene, &file)?;
     let eq = prep.equilibrium(registry, equilibrium, law, mu)?;
@@ -318,14 +483,4 @@ pub fn export(
         prep.set.len()
     );
     Ok(())
-}
-
-/// Parses `key=value` options into plugin parameters.
-pub fn parse_params(opts: &[String]) -> Result<squeal_core::Params> {
-    let mut p = squeal_core::Params::new();
-    for kv in opts {
-        let (k, v) = squeal_core::Params::parse_kv(kv)?;
-        p.0.insert(k, v);
-    }
-    Ok(p)
 }

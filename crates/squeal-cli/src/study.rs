@@ -31,25 +31,8 @@ pub const REGION_COUPLING_1: &str = "0.003,0.003,0.014,0.014";
 /// Options every study shares.
 #[derive(clap::Args)]
 pub struct StudyOpts {
-    /// Reduction basis plugin, or `none` for full order.
-    #[arg(long, default_value = "enriched")]
-    pub basis: String,
-    /// Basis parameters `key=value`.
-    #[arg(long = "basis-opt")]
-    pub basis_opt: Vec<String>,
-    /// Eigen solver plugin; default `arpack`, or `dense` for the reduced problem when a
-    /// basis is given.
-    #[arg(long)]
-    pub eigen: Option<String>,
-    /// Frequency band `FMIN:FMAX` (Hz).
-    #[arg(long, default_value = "0:5000")]
-    pub band: String,
-    /// Relative tolerance of the eigen solvers.
-    #[arg(long, default_value_t = 1e-10)]
-    pub tol: f64,
-    /// A mode is unstable when its DvR exceeds this.
-    #[arg(long, default_value_t = 1e-6)]
-    pub dvr_tol: f64,
+    #[command(flatten)]
+    pub method: crate::opts::MethodArgs,
     /// Coupling classes (Hz): an unstable mode belongs to the nearest within
     /// --class-width.
     #[arg(long, default_value = "2100,3500")]
@@ -57,7 +40,7 @@ pub struct StudyOpts {
     /// Relative half-width of a class.
     #[arg(long, default_value_t = 0.2)]
     pub class_width: f64,
-    /// Cases solved in parallel (each worker with its own basis and solver).
+    /// Cases solved in parallel (each worker with its own basis and solver; >= 1).
     #[arg(long, default_value_t = 1)]
     pub jobs: usize,
     /// Continue the study already in --out (finished cases are skipped).
@@ -76,44 +59,146 @@ pub struct StudyOpts {
 }
 
 /// `squeal sweep macro`.
-pub struct MacroArgs<'a> {
-    pub scene: Option<&'a str>,
-    pub x0: &'a str,
-    pub y0: &'a str,
-    pub a: &'a str,
-    pub b: &'a str,
-    pub mu: &'a str,
-    pub out: &'a Path,
-    pub opts: &'a StudyOpts,
+#[derive(clap::Args)]
+pub struct MacroArgs {
+    #[command(flatten)]
+    scene: crate::opts::SceneArg,
+    /// Zone starts along x (m), or `centred`.
+    #[arg(long, default_value = "centred")]
+    x0: String,
+    /// Zone starts along y (m), or `centred`.
+    #[arg(long, default_value = "centred")]
+    y0: String,
+    /// Zone lengths along x, the sliding direction (m).
+    #[arg(long, default_value = "0.004:0.02:0.002")]
+    a: String,
+    /// Zone widths along y (m); the paper's Figure 12 uses 14.2 mm.
+    #[arg(long, default_value = "0.0142")]
+    b: String,
+    /// Friction coefficients (the paper's 0.36 and 0.43).
+    #[arg(long, default_value = "0.36,0.43")]
+    mu: String,
+    #[command(flatten)]
+    opts: StudyOpts,
+    /// Output directory.
+    #[arg(long, default_value = "out/sweep-macro")]
+    out: PathBuf,
+}
+
+impl MacroArgs {
+    /// Runs (or resumes) the study.
+    pub fn run(&self, registry: &Registry) -> Result<()> {
+        let spec = StudySpec::Macro(MacroSpec {
+            mu: parse_list("--mu", &self.mu)?,
+            x0: Axis::parse("--x0", &self.x0)?,
+            y0: Axis::parse("--y0", &self.y0)?,
+            a_m: parse_list("--a", &self.a)?,
+            b_m: parse_list("--b", &self.b)?,
+        });
+        execute(
+            registry,
+            &self.scene,
+            spec,
+            &self.out,
+            &self.opts,
+            "sweep macro",
+        )
+    }
 }
 
 /// `squeal sweep meso`.
-pub struct MesoArgs<'a> {
-    pub scene: Option<&'a str>,
-    pub coupling: u8,
-    pub region: Option<&'a str>,
-    pub patch: Option<&'a str>,
-    pub layouts: usize,
-    pub fraction: f64,
-    pub seed: u64,
-    pub mu: &'a str,
-    pub out: &'a Path,
-    pub opts: &'a StudyOpts,
+#[derive(clap::Args)]
+pub struct MesoArgs {
+    #[command(flatten)]
+    scene: crate::opts::SceneArg,
+    /// Which coupling's defaults: 2 (2100 Hz: region 0.010,0.003,0.010,0.014, patches
+    /// 0.4-1.6 mm) or 1 (3500 Hz: region 0.003,0.003,0.014,0.014, patches 0.5-3.5 mm).
+    #[arg(long, default_value_t = 2)]
+    coupling: u8,
+    /// Region cut into patches, `x0,y0,a,b` (m from the pin face's corner).
+    #[arg(long)]
+    region: Option<String>,
+    /// Patch sides (m), a list.
+    #[arg(long)]
+    patch: Option<String>,
+    /// Random layouts per patch size.
+    #[arg(long, default_value_t = 200)]
+    layouts: usize,
+    /// Fraction of the patches in contact in each layout, in (0, 1].
+    #[arg(long, default_value_t = 0.5)]
+    fraction: f64,
+    /// Base seed of the layouts.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Friction coefficients.
+    #[arg(long, default_value = "0.36")]
+    mu: String,
+    #[command(flatten)]
+    opts: StudyOpts,
+    /// Output directory.
+    #[arg(long, default_value = "out/sweep-meso")]
+    out: PathBuf,
 }
 
-fn solve_spec(o: &StudyOpts) -> Result<SolveSpec> {
-    let eigen = o
-        .eigen
-        .clone()
-        .unwrap_or_else(|| if o.basis == "none" { "arpack" } else { "dense" }.to_string());
+impl MesoArgs {
+    /// Runs (or resumes) the study.
+    pub fn run(&self, registry: &Registry) -> Result<()> {
+        let (region, patch) = match self.coupling {
+            2 => (REGION_COUPLING_2, PAPER_PATCHES_COUPLING_2),
+            1 => (REGION_COUPLING_1, PAPER_PATCHES_COUPLING_1),
+            c => anyhow::bail!("--coupling {c}: expected 1 (3500 Hz) or 2 (2100 Hz)"),
+        };
+        let spec = StudySpec::Meso(MesoSpec {
+            mu: parse_list("--mu", &self.mu)?,
+            region_m: parse_region("--region", self.region.as_deref().unwrap_or(region))?,
+            patch_m: parse_list("--patch", self.patch.as_deref().unwrap_or(patch))?,
+            layouts: self.layouts,
+            fraction: self.fraction,
+            seed: self.seed,
+        });
+        execute(
+            registry,
+            &self.scene,
+            spec,
+            &self.out,
+            &self.opts,
+            "sweep meso",
+        )
+    }
+}
+
+/// `squeal merge`.
+#[derive(clap::Args)]
+pub struct MergeArgs {
+    /// Study directories (the --out of each shard).
+    #[arg(required = true)]
+    dirs: Vec<PathBuf>,
+    /// Merged directory (must not be one of the inputs).
+    #[arg(long)]
+    out: PathBuf,
+    /// Skip the charts.
+    #[arg(long)]
+    no_charts: bool,
+}
+
+impl MergeArgs {
+    /// Merges the shards.
+    pub fn run(&self) -> Result<()> {
+        check_dirs(&self.dirs)?;
+        merge(&self.dirs, &self.out, self.no_charts)
+    }
+}
+
+fn solve_spec(o: &StudyOpts, scene: &squeal_scene::Scene) -> Result<SolveSpec> {
+    let m = &o.method;
     let s = SolveSpec {
-        basis: o.basis.clone(),
-        basis_params: o.basis_opt.clone(),
-        eigen,
+        basis: m.basis.clone(),
+        basis_params: m.basis_opt.clone(),
+        eigen: m.eigen(),
         modal: "arpack".into(),
-        band_hz: crate::parse_band(&o.band)?,
-        tol: o.tol,
-        dvr_tol: o.dvr_tol,
+        band_hz: m.band_of(scene)?,
+        tol: m.tol,
+        dvr_tol: m.dvr_tol,
         classes_hz: parse_list("--classes", &o.classes)?,
         class_width: o.class_width,
     };
@@ -130,47 +215,26 @@ fn run_options(o: &StudyOpts) -> Result<RunOptions> {
     })
 }
 
-pub fn run_macro(registry: &Registry, a: &MacroArgs<'_>) -> Result<()> {
-    let spec = StudySpec::Macro(MacroSpec {
-        mu: parse_list("--mu", a.mu)?,
-        x0: Axis::parse("--x0", a.x0)?,
-        y0: Axis::parse("--y0", a.y0)?,
-        a_m: parse_list("--a", a.a)?,
-        b_m: parse_list("--b", a.b)?,
-    });
-    execute(registry, a.scene, spec, a.out, a.opts)
-}
-
-pub fn run_meso(registry: &Registry, a: &MesoArgs<'_>) -> Result<()> {
-    let (region, patch) = match a.coupling {
-        2 => (REGION_COUPLING_2, PAPER_PATCHES_COUPLING_2),
-        1 => (REGION_COUPLING_1, PAPER_PATCHES_COUPLING_1),
-        c => anyhow::bail!("--coupling: expected 1 (3500 Hz) or 2 (2100 Hz), got {c}"),
-    };
-    let spec = StudySpec::Meso(MesoSpec {
-        mu: parse_list("--mu", a.mu)?,
-        region_m: parse_region("--region", a.region.unwrap_or(region))?,
-        patch_m: parse_list("--patch", a.patch.unwrap_or(patch))?,
-        layouts: a.layouts,
-        fraction: a.fraction,
-        seed: a.seed,
-    });
-    execute(registry, a.scene, spec, a.out, a.opts)
-}
-
 /// Builds the model and the definition, runs the study with a progress bar, writes the
 /// charts and prints the summary.
 fn execute(
     registry: &Registry,
-    scene_arg: Option<&str>,
+    scene_arg: &crate::opts::SceneArg,
     spec: StudySpec,
     out: &Path,
     o: &StudyOpts,
+    command: &str,
 ) -> Result<()> {
     let start = Instant::now();
-    let solve = solve_spec(o)?;
+    o.method.check(registry)?;
+    if o.jobs == 0 {
+        anyhow::bail!("--jobs 0: expected at least 1 worker");
+    }
     let opts = run_options(o)?;
-    let (scene, file) = crate::load_scene(scene_arg)?;
+    let (scene, file) = scene_arg.load()?;
+    let solve = solve_spec(o, &scene)?;
+    crate::opts::claim_out(out, command)?;
+    crate::opts::set_resume_hint(out);
     eprintln!("building {file} ...");
     let model = squeal_scene::build(&scene, squeal_scene::BodyKind::All, registry, &file)?;
     let def = StudyDef::new(&file, &scene, &model, spec, solve)?;

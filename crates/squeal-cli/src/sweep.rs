@@ -1,16 +1,403 @@
 //! `squeal sweep mu`: the friction-coefficient sweep with mode tracking, coupling
-//! detection, CSV/JSON outputs and the paper's Figure 5 and 7 charts.
+//! detection, CSV/JSON outputs and the paper's Figure 5 and 7 charts; `squeal sweep
+//! param`: the same for the parameter of a parametric operator directory.
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use squeal_analysis::pipeline::{run_mu_sweep, FreeModes, Prepared};
-use squeal_analysis::sweep::{
-    couplings, track, Branch, Checkpoint, Coupling, SweepPoint, TrackOptions,
+use squeal_analysis::family::{reference_modes, run_family_sweep, Parametric, SweepCoupling};
+use squeal_analysis::mu_sweep::{
+    mu_list, run_sweep, value_list, CouplingReport, MuSweep, MuSweepSettings,
 };
-use squeal_core::{EigenParams, FrictionalOperator, Registry};
+use squeal_analysis::pipeline::{FreeModes, Method, Prepared};
+use squeal_analysis::sweep::{Branch, Checkpoint, SweepPoint};
+use squeal_core::{EigenParams, Registry};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+/// `squeal sweep`: the parameter sweeps.
+#[derive(clap::Subcommand)]
+pub enum SweepCmd {
+    /// Friction-coefficient sweep: equilibrium, operator (rebuilt when the contact set
+    /// changes), modes, tracking by MAC, couplings; sweep.csv, summary.json and charts.
+    /// Finished points are kept in DIR/sweep.partial.jsonl: --resume continues a killed run.
+    #[command(allow_negative_numbers = true)]
+    Mu(MuArgs),
+    /// Sweep of the parameter of a parametric operator directory (operator.toml with
+    /// `parameter = "W"`, docs/operators.md) at a fixed mu: the operator at each value,
+    /// modes, tracking by MAC on the real modes of its symmetric part at the first value,
+    /// couplings; the outputs, progress and --resume of `sweep mu`.
+    #[command(allow_negative_numbers = true)]
+    Param(ParamArgs),
+    /// Macroscopic effective zones (paper section 3.1): every rectangle (x0, y0, a, b) of
+    /// the grid of lists, all its pairs closed and sliding, at each mu. Lists are
+    /// comma-separated values and FROM:TO:STEP ranges, in m from the pin face's corner
+    /// (x along sliding, y radial). Writes study.json, results.jsonl, summary.json,
+    /// timings.jsonl, timings.json and charts; resumable (--resume), shardable (--shard).
+    #[command(allow_negative_numbers = true)]
+    Macro(crate::study::MacroArgs),
+    /// Mesoscopic plateaus (paper section 3.2): a fixed region of the pin face cut into
+    /// square patches, seeded random subsets of them in contact (all their pairs closed
+    /// and sliding), --layouts per patch size. Defaults: the paper's patch sizes and mu
+    /// for --coupling 2 (2100 Hz) or 1 (3500 Hz); those patches need a contact grid of
+    /// 0.2 mm / 0.5 mm in the region (mesh.contact_refinement; scenes/pin-on-disc-meso.toml
+    /// and scenes/pin-on-disc-meso-c1.toml): on the default scene (1 mm) give --patch.
+    /// Same outputs, resume and shards as `sweep macro`.
+    #[command(allow_negative_numbers = true)]
+    Meso(crate::study::MesoArgs),
+}
+
+impl SweepCmd {
+    /// Runs the chosen sweep.
+    pub fn run(&self, registry: &Registry) -> Result<()> {
+        match self {
+            SweepCmd::Mu(a) => a.run(registry),
+            SweepCmd::Param(a) => a.run(registry),
+            SweepCmd::Macro(a) => a.run(registry),
+            SweepCmd::Meso(a) => a.run(registry),
+        }
+    }
+}
+
+/// `squeal sweep mu`.
+#[derive(clap::Args)]
+pub struct MuArgs {
+    #[command(flatten)]
+    scene: crate::opts::SceneArg,
+    /// First friction coefficient.
+    #[arg(long, default_value_t = 0.0)]
+    from: f64,
+    /// Last friction coefficient.
+    #[arg(long, default_value_t = 0.8)]
+    to: f64,
+    /// Step (the paper's resolution is 0.01).
+    #[arg(long, default_value_t = 0.01)]
+    step: f64,
+    #[command(flatten)]
+    method: crate::opts::MethodArgs,
+    #[command(flatten)]
+    contact: crate::opts::ContactArgs,
+    /// Condition numbers and forward error estimates of full-order modes also above
+    /// 1000 DOFs (one extra factorization per mode); reduced solves always have them.
+    #[arg(long)]
+    condition: bool,
+    /// Continue the sweep already in --out (its finished points are kept).
+    #[arg(long)]
+    resume: bool,
+    /// Output directory.
+    #[arg(long, default_value = "out/sweep-mu")]
+    out: PathBuf,
+}
+
+impl MuArgs {
+    /// Runs the sweep and prints its couplings.
+    pub fn run(&self, registry: &Registry) -> Result<()> {
+        self.method.check(registry)?;
+        self.contact.check(registry)?;
+        mus(self.from, self.to, self.step)?;
+        let band = self
+            .method
+            .band
+            .as_deref()
+            .map(crate::opts::parse_band)
+            .transpose()?;
+        let eigen = self.method.eigen();
+        let args = Args {
+            scene: self.scene.as_deref(),
+            from: self.from,
+            to: self.to,
+            step: self.step,
+            eigen: &eigen,
+            basis: &self.method.basis,
+            basis_opts: &self.method.basis_opt,
+            band,
+            equilibrium: &self.contact.equilibrium,
+            law: &self.contact.law,
+            dvr_tol: self.method.dvr_tol,
+            tol: self.method.tol,
+            condition: self.condition,
+            resume: self.resume,
+            out: &self.out,
+        };
+        let s = run(registry, &args)?;
+        println!(
+            "{} points ({} contact sets), {} couplings, max backward error {:.1e}, max error \
+             bound {}, {:.1} s",
+            s.points,
+            s.rebuilds,
+            s.couplings.len(),
+            s.max_backward_error,
+            crate::stability::sci(s.max_error_bound),
+            s.time_s
+        );
+        for c in &s.couplings {
+            println!(
+                "  {:>8.1} Hz  mu {:.3}-{:.3}  max DvR {:.4}  partners {:?}",
+                c.freq_hz, c.mu_from, c.mu_to, c.max_dvr, c.partners
+            );
+        }
+        println!(
+            "wrote {}/{{sweep.csv,summary.json,*.svg,*.png}}",
+            self.out.display()
+        );
+        Ok(())
+    }
+}
+
+/// `squeal sweep param`.
+#[derive(clap::Args)]
+pub struct ParamArgs {
+    /// Parametric operator directory (operator.toml with `format =
+    /// "squeal-parametric-operator"`, see docs/operators.md).
+    #[arg(long)]
+    operator: PathBuf,
+    /// The parameter to sweep: the name the operator declares.
+    #[arg(long)]
+    param: String,
+    /// First value.
+    #[arg(long)]
+    from: f64,
+    /// Last value.
+    #[arg(long)]
+    to: f64,
+    /// Step.
+    #[arg(long)]
+    step: f64,
+    /// Friction coefficient of every point (required when the operator has friction
+    /// parts FM, FC or FK).
+    #[arg(long)]
+    mu: Option<f64>,
+    #[command(flatten)]
+    method: crate::opts::MethodArgs,
+    /// Condition numbers and forward error estimates of full-order modes also above
+    /// 1000 DOFs (one extra factorization per mode); reduced solves always have them.
+    #[arg(long)]
+    condition: bool,
+    /// Continue the sweep already in --out (its finished points are kept).
+    #[arg(long)]
+    resume: bool,
+    /// Output directory.
+    #[arg(long, default_value = "out/sweep-param")]
+    out: PathBuf,
+}
+
+/// `summary.json` of `squeal sweep param`.
+#[derive(Serialize)]
+pub struct ParamSummary {
+    pub operator: String,
+    pub units: &'static str,
+    /// The swept parameter's name.
+    pub parameter: String,
+    /// `[from, to, step]` as given.
+    pub range: [f64; 3],
+    pub mu: f64,
+    pub band_hz: [f64; 2],
+    pub eigen: String,
+    pub basis: String,
+    pub dofs: usize,
+    pub dvr_tol: f64,
+    pub points: usize,
+    pub max_basis_size: usize,
+    pub max_backward_error: f64,
+    /// Worst `error_bound` of every point's modes (null: not computed).
+    pub max_error_bound: f64,
+    /// What the signatures of tracking are taken on.
+    pub reference: String,
+    pub reference_modes: usize,
+    pub time_s: f64,
+    /// Couplings: frequency at the largest DvR, first and last unstable value, largest
+    /// DvR, branches, and the reference modes the unstable mode is made of.
+    pub couplings: Vec<SweepCoupling>,
+}
+
+impl ParamArgs {
+    /// Checks every option, runs the sweep and prints its couplings.
+    pub fn run(&self, registry: &Registry) -> Result<()> {
+        let start = Instant::now();
+        self.method.check(registry)?;
+        let values = value_list(self.from, self.to, self.step)
+            .map_err(|e| anyhow::anyhow!("--from/--to/--step: {e}"))?;
+        if let Some(mu) = self.mu {
+            crate::opts::check_mu("--mu", mu)?;
+        }
+        let band = self.method.band(crate::opts::OPERATOR_BAND_HZ)?;
+        let name = self.param.as_str();
+        let flag = format!("--param {name}");
+        let dir = &self.operator;
+        let family_op = crate::opts::read_parametric(dir, name, &flag)?;
+        if let Some((lo, hi)) = family_op.range() {
+            let last = *values.last().expect("a value list is never empty");
+            if values[0] < lo || last > hi {
+                anyhow::bail!(
+                    "--from/--to: {name} = {} ... {last} leaves the range [{lo}, {hi}] the \
+                     operator in {} declares",
+                    values[0],
+                    dir.display()
+                );
+            }
+        }
+        let first = family_op
+            .at(values[0])
+            .map_err(|e| anyhow::anyhow!("--from {}: {e}", values[0]))?;
+        first.check_pencil().map_err(|e| {
+            anyhow::anyhow!(
+                "--operator {} at {name} = {}: {e}",
+                dir.display(),
+                values[0]
+            )
+        })?;
+        let frictional = first.fm.compute_nnz() > 0
+            || first.fk.compute_nnz() > 0
+            || first.fc.as_ref().is_some_and(|f| f.compute_nnz() > 0);
+        let mu = match self.mu {
+            Some(mu) => mu,
+            None if frictional => anyhow::bail!(
+                "--mu: required, the operator in {} has friction parts (X - mu F_X)",
+                dir.display()
+            ),
+            None => 0.0,
+        };
+        // the points depend on these (not on the value list, except its first value,
+        // where the reference modes of tracking are taken)
+        let toml = std::fs::read_to_string(dir.join("operator.toml")).unwrap_or_default();
+        let mut inputs = serde_json::json!({
+            "operator": dir.display().to_string(),
+            "operator_toml": toml,
+            "parameter": name,
+            "reference_value": values[0],
+            "mu": mu,
+            "basis": self.method.basis,
+            "basis_opts": format!("{:?}", self.method.basis_params()?),
+            "eigen": self.method.eigen(),
+            "band_hz": band,
+            "tol": self.method.tol,
+            "squeal": env!("CARGO_PKG_VERSION"),
+        });
+        if self.condition {
+            inputs["condition"] = true.into();
+        }
+        let out = &self.out;
+        let (ckpt, done) = open_checkpoint(
+            out,
+            "sweep param",
+            "a parameter sweep",
+            self.resume,
+            &inputs,
+        )?;
+        let reference = reference_modes(registry, &first, "arpack", 1.5 * band[1])
+            .with_context(|| format!("--operator {} at {name} = {}", dir.display(), values[0]))?;
+        let mut method = Method::new(
+            registry,
+            &self.method.basis,
+            &self.method.basis_params()?,
+            &self.method.eigen(),
+            "arpack",
+            EigenParams {
+                fmin_hz: band[0],
+                fmax_hz: band[1],
+                tol: self.method.tol,
+                ..EigenParams::default()
+            },
+        )?;
+        method.set_condition(self.condition);
+        let mut eta = crate::opts::Eta::new(values.len(), done);
+        let dvr_tol = self.method.dvr_tol;
+        let mut family = Parametric::new(&family_op, mu);
+        let sweep = run_family_sweep(
+            &mut family,
+            &values,
+            &mut method,
+            &reference,
+            dvr_tol,
+            &[],
+            Some(&ckpt),
+            |p| {
+                let unstable = p.modes.iter().filter(|m| m.dvr > dvr_tol).count();
+                eprintln!(
+                    "{} {name} {}: {} modes, {} unstable, max error bound {}, solve {:.2} s",
+                    eta.tick(),
+                    p.value,
+                    p.modes.len(),
+                    unstable,
+                    crate::stability::sci(crate::stability::worst(
+                        &p.modes.iter().map(|m| m.error_bound).collect::<Vec<_>>()
+                    )),
+                    p.times_s[2]
+                );
+            },
+        )
+        .with_context(|| format!("the sweep of {name}"))?;
+        let axis = Axis::param(name);
+        let points = &sweep.points;
+        write_csv(
+            &out.join("sweep.csv"),
+            name,
+            points,
+            &sweep.branches,
+            dvr_tol,
+        )?;
+        charts(out, &axis, points, &sweep.branches, dvr_tol)?;
+        mac_charts(out, &axis, &sweep.couplings)?;
+        let summary = ParamSummary {
+            operator: dir.display().to_string(),
+            units: "SI: frequencies in Hz, DvR = Re/Im (dimensionless), times in s",
+            parameter: name.to_string(),
+            range: [self.from, self.to, self.step],
+            mu,
+            band_hz: band,
+            eigen: self.method.eigen(),
+            basis: self.method.basis.clone(),
+            dofs: first.dim(),
+            dvr_tol,
+            points: points.len(),
+            max_basis_size: points.iter().map(|p| p.basis_size).max().unwrap_or(0),
+            max_backward_error: points
+                .iter()
+                .flat_map(|p| p.modes.iter().map(|m| m.backward_error))
+                .fold(0.0, f64::max),
+            max_error_bound: max_error_bound(points),
+            reference: reference_text(name, values[0], &reference),
+            reference_modes: reference.freq_hz.len(),
+            time_s: start.elapsed().as_secs_f64(),
+            couplings: sweep.couplings.clone(),
+        };
+        std::fs::write(
+            out.join("summary.json"),
+            serde_json::to_string_pretty(&summary)?,
+        )?;
+        println!(
+            "{} points of {name} at mu = {mu}, {} couplings, max backward error {:.1e}, max \
+             error bound {}, {:.1} s",
+            summary.points,
+            summary.couplings.len(),
+            summary.max_backward_error,
+            crate::stability::sci(summary.max_error_bound),
+            summary.time_s
+        );
+        for c in &summary.couplings {
+            println!(
+                "  {:>8.1} Hz  {name} {}-{}  max DvR {:.4}  partners {:?}",
+                c.freq_hz, c.from, c.to, c.max_dvr, c.partners
+            );
+        }
+        println!(
+            "wrote {}/{{sweep.csv,summary.json,*.svg,*.png}}",
+            out.display()
+        );
+        Ok(())
+    }
+}
+
+/// What the reference modes of a parameter sweep are.
+fn reference_text(name: &str, value: f64, reference: &FreeModes) -> String {
+    format!(
+        "{} real modes ({:.1} to {:.1} Hz) of the symmetric parts of M and K at {name} = \
+         {value} (no damping, gyroscopic, circulatory or friction term)",
+        reference.freq_hz.len(),
+        reference.freq_hz.first().copied().unwrap_or(0.0),
+        reference.freq_hz.last().copied().unwrap_or(0.0),
+    )
+}
 
 /// Inputs of a sweep.
 pub struct Args<'a> {
@@ -21,10 +408,16 @@ pub struct Args<'a> {
     pub eigen: &'a str,
     pub basis: &'a str,
     pub basis_opts: &'a [String],
-    pub band: [f64; 2],
+    /// `None`: the scene's `study.band_hz`.
+    pub band: Option<[f64; 2]>,
     pub equilibrium: &'a str,
     pub law: &'a str,
     pub dvr_tol: f64,
+    pub tol: f64,
+    /// Condition numbers of full-order modes above the solvers' automatic size.
+    pub condition: bool,
+    /// Continue the sweep in `out` (else a directory holding one is refused).
+    pub resume: bool,
     pub out: &'a Path,
 }
 
@@ -45,121 +438,116 @@ pub struct Summary {
     pub rebuilds: usize,
     pub max_basis_size: usize,
     pub max_backward_error: f64,
+    /// Worst forward error estimate (`error_bound`) of every point's modes (null: not
+    /// computed).
+    pub max_error_bound: f64,
     pub free_interface_modes: usize,
     pub time_s: f64,
-    pub couplings: Vec<CouplingOut>,
+    pub couplings: Vec<CouplingReport>,
 }
 
-#[derive(Serialize)]
-pub struct CouplingOut {
-    pub freq_hz: f64,
-    pub mu_from: f64,
-    pub mu_to: f64,
-    pub max_dvr: f64,
-    pub partners: Vec<usize>,
-    /// The free-interface modes the unstable mode is made of (MAC > 0.1 at its peak).
-    pub free_interface_mac: Vec<(String, f64)>,
-}
-
+/// The range rule of every mu list (`--from/--to/--step`).
 pub fn mus(from: f64, to: f64, step: f64) -> Result<Vec<f64>> {
-    if !(from.is_finite()
-        && to.is_finite()
-        && step.is_finite()
-        && from >= 0.0
-        && to >= from
-        && step > 0.0)
-    {
-        anyhow::bail!(
-            "--from/--to/--step: expected 0 <= from <= to and step > 0, got {from}, {to}, {step}"
-        );
-    }
-    let n = ((to - from) / step + 1e-9).floor() as usize;
-    Ok((0..=n)
-        .map(|k| ((from + k as f64 * step) * 1e12).round() / 1e12)
-        .collect())
+    mu_list(from, to, step).map_err(|e| anyhow::anyhow!("--from/--to/--step: {e}"))
 }
 
 pub fn run(registry: &Registry, a: &Args<'_>) -> Result<Summary> {
-    let start = Instant::now();
     let mus = mus(a.from, a.to, a.step)?;
-    let (scene, file) = crate::load_scene(a.scene)?;
-    std::fs::create_dir_all(a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    let scene_toml = scene.to_toml();
+    let (scene, file) = crate::opts::load_scene(a.scene)?;
+    let band = a.band.unwrap_or(scene.study.band_hz);
+    crate::opts::check_band_against(band, &scene)?;
     let prep = Prepared::new(registry, scene, &file)?;
-    let free = prep
-        .free_interface_modes(registry, "arpack", 1.5 * a.band[1])
-        .context("free-interface modes (the reference of tracking)")?;
-    let params = EigenParams {
-        fmin_hz: a.band[0],
-        fmax_hz: a.band[1],
-        tol: 1e-10,
-        ..EigenParams::default()
-    };
-    let mut method = squeal_analysis::pipeline::Method::new(
-        registry,
-        a.basis,
-        &crate::stability::parse_params(a.basis_opts)?,
-        a.eigen,
-        "arpack",
-        params,
-    )?;
-    method.prepare_free_interface(&prep.model, &prep.set)?;
-    let step = |op: &FrictionalOperator, mu: f64, rebuilt: bool| method.solve(op, mu, rebuilt);
-    let ckpt = Checkpoint::new(a.out.join("sweep.partial.jsonl"));
-    // the points depend on these (not on the mu list: shards and extensions share them)
-    let inputs = serde_json::json!({
-        "scene": scene_toml,
-        "basis": a.basis,
-        "basis_opts": a.basis_opts,
-        "eigen": a.eigen,
-        "equilibrium": a.equilibrium,
-        "law": a.law,
-        "band_hz": a.band,
-        "squeal": env!("CARGO_PKG_VERSION"),
-    });
-    ckpt.claim(&inputs).map_err(anyhow::Error::msg)?;
-    let points = run_mu_sweep(
-        &prep,
-        registry,
-        &mus,
-        a.equilibrium,
-        a.law,
-        &free,
-        Some(&ckpt),
-        step,
-        |p| {
-            let unstable = p.modes.iter().filter(|m| m.dvr > a.dvr_tol).count();
-            eprintln!(
-                "mu {:.3}: {} modes, {} unstable, {} active pairs{}, solve {:.2} s",
-                p.mu,
-                p.modes.len(),
-                unstable,
-                p.active_pairs,
-                if p.rebuilt { " (new contact set)" } else { "" },
-                p.times_s[2]
-            );
-        },
-    )?;
-    let branches = track(&points, &TrackOptions::default());
-    let cps = couplings(&points, &branches, a.dvr_tol);
-    write_csv(&a.out.join("sweep.csv"), &points, &branches, a.dvr_tol)?;
-    charts(a.out, &points, &branches, a.dvr_tol)?;
-    let coupled: Vec<CouplingOut> = cps
-        .iter()
-        .map(|c| coupling_out(c, &points, &branches, &free))
-        .collect();
-    mac_charts(a.out, &coupled)?;
-    let summary = Summary {
-        scene: file,
-        units: "SI: frequencies in Hz, DvR = Re/Im (dimensionless), times in s",
-        mu: [a.from, a.to, a.step],
-        band_hz: a.band,
+    let settings = MuSweepSettings {
+        basis_params: crate::opts::parse_params(a.basis_opts)?,
         eigen: a.eigen.into(),
-        basis: a.basis.into(),
         equilibrium: a.equilibrium.into(),
         law: a.law.into(),
-        dofs: prep.model.dofs.n_free(),
         dvr_tol: a.dvr_tol,
+        tol: a.tol,
+        condition: a.condition,
+        ..MuSweepSettings::new(mus, a.basis, band)
+    };
+    Ok(run_on(
+        registry,
+        &prep,
+        &settings,
+        [a.from, a.to, a.step],
+        a.out,
+        a.resume,
+    )?
+    .0)
+}
+
+/// Runs the sweep `settings` of `prep` into `out` (checkpoint, CSV, charts, summary):
+/// the command's work, shared with `validate`. `range` is `[from, to, step]` as given.
+pub fn run_on(
+    registry: &Registry,
+    prep: &Prepared,
+    settings: &MuSweepSettings,
+    range: [f64; 3],
+    out: &Path,
+    resume: bool,
+) -> Result<(Summary, MuSweep)> {
+    let start = Instant::now();
+    // the points depend on these (not on the mu list: shards and extensions share them)
+    let mut inputs = serde_json::json!({
+        "scene": prep.scene.to_toml(),
+        "basis": settings.basis,
+        "basis_opts": format!("{:?}", settings.basis_params),
+        "eigen": settings.eigen,
+        "equilibrium": settings.equilibrium,
+        "law": settings.law,
+        "band_hz": settings.band_hz,
+        "tol": settings.tol,
+        "squeal": env!("CARGO_PKG_VERSION"),
+    });
+    if settings.condition {
+        inputs["condition"] = true.into();
+    }
+    let (ckpt, done) = open_checkpoint(out, "sweep mu", "a mu sweep", resume, &inputs)?;
+    let mut eta = crate::opts::Eta::new(settings.mus.len(), done);
+    let dvr_tol = settings.dvr_tol;
+    let sweep = run_sweep(registry, prep, settings, Some(&ckpt), |p| {
+        let unstable = p.modes.iter().filter(|m| m.dvr > dvr_tol).count();
+        eprintln!(
+            "{} mu {:.3}: {} modes, {} unstable, {} active pairs{}, solve {:.2} s",
+            eta.tick(),
+            p.mu,
+            p.modes.len(),
+            unstable,
+            p.active_pairs,
+            if p.rebuilt { " (new contact set)" } else { "" },
+            p.times_s[2]
+        );
+    })
+    .context("the mu sweep")?;
+    let (points, branches, free) = (&sweep.points, &sweep.branches, &sweep.free);
+    write_csv(&out.join("sweep.csv"), "mu", points, branches, dvr_tol)?;
+    charts(out, &Axis::mu(), points, branches, dvr_tol)?;
+    let makeup: Vec<SweepCoupling> = sweep
+        .couplings
+        .iter()
+        .map(|c| SweepCoupling {
+            freq_hz: c.freq_hz,
+            from: c.mu_from,
+            to: c.mu_to,
+            max_dvr: c.max_dvr,
+            partners: c.partners.clone(),
+            makeup: c.free_interface_mac.clone(),
+        })
+        .collect();
+    mac_charts(out, &Axis::mu(), &makeup)?;
+    let summary = Summary {
+        scene: prep.file.clone(),
+        units: "SI: frequencies in Hz, DvR = Re/Im (dimensionless), times in s",
+        mu: range,
+        band_hz: settings.band_hz,
+        eigen: settings.eigen.clone(),
+        basis: settings.basis.clone(),
+        equilibrium: settings.equilibrium.clone(),
+        law: settings.law.clone(),
+        dofs: prep.model.dofs.n_free(),
+        dvr_tol,
         points: points.len(),
         rebuilds: points.iter().filter(|p| p.rebuilt).count(),
         max_basis_size: points.iter().map(|p| p.basis_size).max().unwrap_or(0),
@@ -167,62 +555,113 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<Summary> {
             .iter()
             .flat_map(|p| p.modes.iter().map(|m| m.backward_error))
             .fold(0.0, f64::max),
+        max_error_bound: max_error_bound(points),
         free_interface_modes: free.freq_hz.len(),
         time_s: start.elapsed().as_secs_f64(),
-        couplings: coupled,
+        couplings: sweep.couplings.clone(),
     };
     std::fs::write(
-        a.out.join("summary.json"),
+        out.join("summary.json"),
         serde_json::to_string_pretty(&summary)?,
     )?;
-    Ok(summary)
+    Ok((summary, sweep))
 }
 
-fn coupling_out(
-    c: &Coupling,
+/// Claims `out` for `command` and opens its checkpoint: refuses a directory holding `what`
+/// (finished points or a summary) without `resume`, and a checkpoint of other `inputs`.
+/// Returns the checkpoint and how many points it holds.
+fn open_checkpoint(
+    out: &Path,
+    command: &str,
+    what: &str,
+    resume: bool,
+    inputs: &serde_json::Value,
+) -> Result<(Checkpoint, usize)> {
+    crate::opts::claim_out(out, command)?;
+    let ckpt_path = out.join("sweep.partial.jsonl");
+    let done = Checkpoint::new(ckpt_path.clone())
+        .load()
+        .map(|p| p.len())
+        .unwrap_or(0);
+    if (done > 0 || out.join("summary.json").is_file()) && !resume {
+        anyhow::bail!(
+            "--out {}: holds {what} ({done} finished points): pass --resume to continue it, \
+             or choose another directory",
+            out.display()
+        );
+    }
+    if done > 0 {
+        eprintln!(
+            "resuming: {done} points already computed in {}",
+            ckpt_path.display()
+        );
+    }
+    crate::opts::set_resume_hint(out);
+    let ckpt = Checkpoint::new(ckpt_path);
+    ckpt.claim(inputs).map_err(anyhow::Error::msg)?;
+    Ok((ckpt, done))
+}
+
+/// The worst `error_bound` of every point's modes (NaN when none was computed).
+fn max_error_bound(points: &[SweepPoint]) -> f64 {
+    let all: Vec<f64> = points
+        .iter()
+        .flat_map(|p| p.modes.iter().map(|m| m.error_bound))
+        .collect();
+    crate::stability::worst(&all)
+}
+
+/// The swept quantity of charts and CSV: its column name, its axis label and the modes
+/// the signatures are taken on (one of them, and all of them).
+struct Axis {
+    column: String,
+    label: String,
+    item: &'static str,
+    reference: &'static str,
+}
+
+impl Axis {
+    fn mu() -> Self {
+        Self {
+            column: "mu".into(),
+            label: "friction coefficient mu".into(),
+            item: "free-interface mode",
+            reference: "the free-interface modes",
+        }
+    }
+
+    fn param(name: &str) -> Self {
+        Self {
+            column: name.into(),
+            label: format!("parameter {name}"),
+            item: "reference mode",
+            reference: "the reference modes",
+        }
+    }
+}
+
+fn write_csv(
+    path: &Path,
+    column: &str,
     points: &[SweepPoint],
     branches: &[Branch],
-    free: &FreeModes,
-) -> CouplingOut {
-    // the unstable mode at its peak
-    let b = &branches[c.partners[0]];
-    let peak = (0..points.len())
-        .filter_map(|p| b.modes[p].map(|m| (p, m)))
-        .max_by(|x, y| {
-            points[x.0].modes[x.1]
-                .dvr
-                .total_cmp(&points[y.0].modes[y.1].dvr)
-        });
-    let mut mac = Vec::new();
-    if let Some((p, m)) = peak {
-        let sig = &points[p].modes[m].signature;
-        let total: f64 = sig.iter().map(|z| z[0] * z[0] + z[1] * z[1]).sum();
-        for (k, z) in sig.iter().enumerate() {
-            let v = (z[0] * z[0] + z[1] * z[1]) / total.max(f64::MIN_POSITIVE);
-            if v > 0.1 {
-                mac.push((format!("{} ({:.0} Hz)", free.labels[k], free.freq_hz[k]), v));
-            }
-        }
-        mac.sort_by(|x, y| y.1.total_cmp(&x.1));
-    }
-    CouplingOut {
-        freq_hz: c.freq_hz,
-        mu_from: c.mu_from,
-        mu_to: c.mu_to,
-        max_dvr: c.max_dvr,
-        partners: c.partners.clone(),
-        free_interface_mac: mac,
-    }
-}
-
-fn write_csv(path: &Path, points: &[SweepPoint], branches: &[Branch], tol: f64) -> Result<()> {
+    tol: f64,
+) -> Result<()> {
     let mut f = std::io::BufWriter::new(
         std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?,
     );
     writeln!(
         f,
-        "mu,branch,mode,freq_hz,re,dvr,unstable,backward_error,active_pairs,basis_size"
+        "{column},branch,mode,freq_hz,re,dvr,unstable,backward_error,cond,error_bound,active_pairs,basis_size"
     )?;
+    // an estimate that was not computed is an empty field
+    let num = |x: f64| {
+        if x.is_nan() {
+            String::new()
+        } else {
+            format!("{x:.3e}")
+        }
+    };
     for (p, pt) in points.iter().enumerate() {
         for (m, md) in pt.modes.iter().enumerate() {
             let b = branches
@@ -231,15 +670,18 @@ fn write_csv(path: &Path, points: &[SweepPoint], branches: &[Branch], tol: f64) 
                 .map_or(usize::MAX, |b| b.id);
             writeln!(
                 f,
-                "{},{},{},{:.6},{:.6e},{:.6e},{},{:.3e},{},{}",
-                pt.mu,
+                "{},{},{},{:.6},{:.6e},{:.6e},{},{:.3e},{},{},{},{}",
+                pt.value,
                 b,
                 m,
                 md.freq_hz,
-                md.re,
-                md.dvr,
+                // `+ 0.0` writes an undamped mode's -0 as 0
+                md.re + 0.0,
+                md.dvr + 0.0,
                 u8::from(md.dvr > tol),
                 md.backward_error,
+                num(md.cond),
+                num(md.error_bound),
                 pt.active_pairs,
                 pt.basis_size
             )?;
@@ -250,6 +692,7 @@ fn write_csv(path: &Path, points: &[SweepPoint], branches: &[Branch], tol: f64) 
 
 fn charts(
     out: &Path,
+    axis: &Axis,
     points: &[SweepPoint],
     branches: &[Branch],
     tol: f64,
@@ -266,7 +709,7 @@ fn charts(
                     name: String::new(),
                     points: pts
                         .iter()
-                        .map(|&(p, m)| (points[p].mu, y(&points[p].modes[m])))
+                        .map(|&(p, m)| (points[p].value, y(&points[p].modes[m])))
                         .collect(),
                     style: SeriesStyle::LineMarkers,
                     highlight: pts
@@ -278,9 +721,9 @@ fn charts(
             .collect()
     };
     let mut files = line_chart(
-        &out.join("frequency_vs_mu"),
+        &out.join(format!("frequency_vs_{}", axis.column)),
         "Frequency of the tracked modes (unstable in red)",
-        "friction coefficient mu",
+        &axis.label,
         "frequency (Hz)",
         &series(&|m| m.freq_hz),
         &ChartOptions {
@@ -289,9 +732,9 @@ fn charts(
         },
     )?;
     files.extend(line_chart(
-        &out.join("dvr_vs_mu"),
+        &out.join(format!("dvr_vs_{}", axis.column)),
         "Divergence rate Re/Im of the tracked modes (unstable in red)",
-        "friction coefficient mu",
+        &axis.label,
         "DvR = Re(lambda)/Im(lambda)",
         &series(&|m| m.dvr),
         &ChartOptions {
@@ -303,20 +746,22 @@ fn charts(
     Ok(files)
 }
 
-fn mac_charts(out: &Path, couplings: &[CouplingOut]) -> Result<()> {
+/// One bar chart per coupling: the MAC of the unstable mode with the reference modes of
+/// the signatures.
+fn mac_charts(out: &Path, axis: &Axis, couplings: &[SweepCoupling]) -> Result<()> {
     for (i, c) in couplings.iter().enumerate() {
-        if c.free_interface_mac.is_empty() {
+        if c.makeup.is_empty() {
             continue;
         }
         squeal_plot::bar_chart(
             &out.join(format!("mac_coupling_{}", i + 1)),
             &format!(
-                "Unstable mode near {:.0} Hz (mu {}-{}): MAC with the free-interface modes",
-                c.freq_hz, c.mu_from, c.mu_to
+                "Unstable mode near {:.0} Hz ({} {}-{}): MAC with {}",
+                c.freq_hz, axis.column, c.from, c.to, axis.reference
             ),
-            "free-interface mode",
+            axis.item,
             "MAC",
-            &c.free_interface_mac,
+            &c.makeup,
         )?;
     }
     Ok(())

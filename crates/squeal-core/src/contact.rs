@@ -140,6 +140,46 @@ impl FrictionalOperator {
         self.t.as_ref().map_or(self.dim(), |t| t.len())
     }
 
+    /// Checks what every operator of a structure satisfies, for operators read from
+    /// files: `M_c` has a positive diagonal (a zero or negated mass is not a mass) and
+    /// `K_c` a non-negative one (a negated stiffness). The error counts the offending
+    /// diagonal entries and names the first.
+    pub fn check_pencil(&self) -> Result<()> {
+        for (name, mat, strict) in [("M_c", &self.mc, true), ("K_c", &self.kc, false)] {
+            let n = mat.nrows();
+            let mut diag = vec![0.0f64; n];
+            let m = mat.as_ref();
+            for j in 0..mat.ncols() {
+                for (i, v) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+                    if i == j {
+                        diag[j] += *v;
+                    }
+                }
+            }
+            let bad: Vec<usize> = (0..n)
+                .filter(|&i| {
+                    let d = diag[i];
+                    !d.is_finite() || d < 0.0 || (strict && d == 0.0)
+                })
+                .collect();
+            if let Some(&first) = bad.first() {
+                return Err(Error::Invalid(format!(
+                    "{name}: {} of {n} diagonal entries are {} (first: row {first}, {:e}): \
+                     expected a {} matrix",
+                    bad.len(),
+                    if strict { "not positive" } else { "negative" },
+                    diag[first],
+                    if strict {
+                        "positive definite mass"
+                    } else {
+                        "positive semi-definite stiffness"
+                    }
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// The QEP at friction coefficient `mu`: `X~ = X_c - mu F_X`.
     pub fn at(&self, mu: f64) -> Result<Qep> {
         if !mu.is_finite() {

@@ -43,6 +43,9 @@ pub struct EigenParams {
     pub nev_hint: Option<usize>,
     /// Problems up to this size are solved densely (reported in the notes).
     pub dense_below: usize,
+    /// Most modes a band may hold: a band that holds more (a band top far above what
+    /// the model resolves) is refused instead of computing the whole spectrum.
+    pub max_modes: usize,
 }
 
 impl Default for EigenParams {
@@ -55,6 +58,7 @@ impl Default for EigenParams {
             shift_hz: None,
             nev_hint: None,
             dense_below: 120,
+            max_modes: 3000,
         }
     }
 }
@@ -234,6 +238,9 @@ pub fn solve_symmetric_band(
                 break (lam, out.vectors);
             }
             let grown = (nev * 2).min(n - 1);
+            if grown > params.max_modes {
+                return Err(too_many_modes(params));
+            }
             info.notes.push(format!(
                 "{nev} pairs all below the band top; retried with {grown}"
             ));
@@ -297,6 +304,18 @@ pub fn finish_real_modes(
         residuals,
         info,
     }
+}
+
+/// The error of a band that holds more than `max_modes` modes.
+pub fn too_many_modes(p: &EigenParams) -> Error {
+    Error::param(
+        "fmax_hz",
+        format!(
+            "the band {}-{} Hz holds more than {} modes: a band top far above what the \
+             model resolves (lower the band top)",
+            p.fmin_hz, p.fmax_hz, p.max_modes
+        ),
+    )
 }
 
 /// Checks the band (`0 <= fmin < fmax`, finite, in Hz) and the tolerance (`0 < tol < 1`).

@@ -19,6 +19,21 @@ pub enum ParamValue {
     List(Vec<f64>),
 }
 
+impl std::fmt::Display for ParamValue {
+    /// The value as a user writes it: `0.3`, `abc`, `true`, `0.1,0.2`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ParamValue::Num(x) => write!(f, "{x}"),
+            ParamValue::Str(s) => write!(f, "`{s}`"),
+            ParamValue::Bool(b) => write!(f, "{b}"),
+            ParamValue::List(l) => {
+                let parts: Vec<String> = l.iter().map(|x| x.to_string()).collect();
+                write!(f, "{}", parts.join(","))
+            }
+        }
+    }
+}
+
 /// An ordered map of named parameters.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Params(pub BTreeMap<String, ParamValue>);
@@ -72,7 +87,7 @@ impl Params {
             Some(ParamValue::Num(x)) if x.is_finite() => Ok(*x),
             Some(other) => Err(Error::param(
                 key,
-                format!("expected a finite number, got {other:?}"),
+                format!("expected a finite number, got {other}"),
             )),
         }
     }
@@ -102,10 +117,7 @@ impl Params {
         match self.0.get(key) {
             None => Ok(default),
             Some(ParamValue::Str(s)) => Ok(s),
-            Some(other) => Err(Error::param(
-                key,
-                format!("expected a string, got {other:?}"),
-            )),
+            Some(other) => Err(Error::param(key, format!("expected a string, got {other}"))),
         }
     }
 
@@ -116,7 +128,7 @@ impl Params {
             Some(ParamValue::List(l)) => Ok(l.clone()),
             Some(other) => Err(Error::param(
                 key,
-                format!("expected a list of numbers, got {other:?}"),
+                format!("expected a list of numbers, got {other}"),
             )),
         }
     }

@@ -31,8 +31,14 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
+pub mod condition;
 #[cfg(test)]
 mod tests;
+
+use condition::LeftSource;
+pub use condition::{
+    left_eigenvectors, Condition, LeftInfo, CLUSTER_REL, CONDITION_AUTO_MAX_DIM, DENSE_LEFT_MAX_DIM,
+};
 
 /// One quadratic eigenproblem `(lambda^2 M + lambda C + K) u = 0` (one mu, one contact set).
 #[derive(Debug, Clone)]
@@ -65,6 +71,18 @@ pub struct ComplexModes {
     pub dvr: Vec<f64>,
     /// Backward error of each pair on the operator (see module docs).
     pub backward_error: Vec<f64>,
+    /// Condition number of each eigenvalue,
+    /// `||y|| ||x|| (|lambda|^2 ||M|| + |lambda| ||C|| + ||K||) / (|lambda| |y^H Q'(lambda) x|)`
+    /// with the left eigenvector `y`; NaN where no left vector was computed (see
+    /// [`Condition`] and the [`condition`] module for what it promises and where it fails).
+    pub cond: Vec<f64>,
+    /// First-order estimate of the relative forward error of each eigenvalue,
+    /// `|lambda - lambda_exact| / |lambda| <~ cond * backward_error`; NaN where `cond` is.
+    pub error_bound: Vec<f64>,
+    /// The left eigenvectors behind `cond` (`y^H Q(lambda) = 0`), one column per mode,
+    /// unit 2-norm except inside a cluster of (nearly) equal eigenvalues, where they are
+    /// bi-orthogonalized against the right vectors; `None` when not computed.
+    pub left_vectors: Option<Mat<c64>>,
     /// How the solve went.
     pub info: SolveInfo,
 }
@@ -78,9 +96,10 @@ impl ComplexModes {
     pub fn is_empty(&self) -> bool {
         self.lambda.is_empty()
     }
-    /// Whether mode `i` is unstable (`Re(lambda) > 0` beyond `rel_tol |lambda|`).
-    pub fn is_unstable(&self, i: usize, rel_tol: f64) -> bool {
-        self.lambda[i].re > rel_tol * self.lambda[i].norm()
+    /// Whether mode `i` is unstable: its divergence rate `DvR = Re / Im` exceeds
+    /// `dvr_tol` (the one threshold of every command, `--dvr-tol`).
+    pub fn is_unstable(&self, i: usize, dvr_tol: f64) -> bool {
+        self.dvr[i] > dvr_tol
     }
 }
 
@@ -387,6 +406,13 @@ impl<'a> QepShiftInvert<'a> {
         self.lu
             .solve_in_place(MatMut::from_column_major_slice_mut(y, n, 1));
     }
+    /// `y <- Q(sigma)^-H y` with the same factorization (length `n`): inverse iteration
+    /// for left eigenvectors.
+    pub fn solve_adjoint_in_place(&self, y: &mut [c64]) {
+        let n = y.len();
+        self.lu
+            .solve_adjoint_in_place(MatMut::from_column_major_slice_mut(y, n, 1));
+    }
 }
 
 impl ComplexLinOp for QepShiftInvert<'_> {
@@ -575,6 +601,9 @@ pub struct QepBandOptions {
     /// `K~ - s M~`. Only [`solve_frictional_band_with`] can use it (it needs the parts of
     /// the operator); [`solve_qep_band_with`] ignores it.
     pub low_rank: LowRank,
+    /// Whether the modes get left eigenvectors, condition numbers and forward error
+    /// estimates (one extra factorization per mode, see [`Condition`]).
+    pub condition: Condition,
 }
 
 /// Choice of the low-rank (Woodbury) path of the band driver, see
@@ -605,6 +634,7 @@ impl Default for QepBandOptions {
             nev_default: 24,
             squared_when_undamped: true,
             low_rank: LowRank::Auto,
+            condition: Condition::Auto,
         }
     }
 }
@@ -805,7 +835,14 @@ fn band_solve(
         let (lambda, vectors) = dense_qep(qep)?;
         info.requested = lambda.len();
         info.converged = lambda.len();
-        let mut modes = finish_modes(qep, &lambda, vectors.as_ref(), params, info)?;
+        let mut modes = finish_modes_with(
+            qep,
+            &lambda,
+            vectors.as_ref(),
+            params,
+            info,
+            options.condition,
+        )?;
         modes.info.time_s = start.elapsed().as_secs_f64();
         return Ok(modes);
     }
@@ -840,7 +877,14 @@ fn band_solve(
             vectors[(r, c)] = v[r];
         }
     }
-    let mut modes = finish_modes(qep, &run.lambda, vectors.as_ref(), params, run.info)?;
+    let mut modes = finish_modes_with(
+        qep,
+        &run.lambda,
+        vectors.as_ref(),
+        params,
+        run.info,
+        options.condition,
+    )?;
     modes.info.time_s = start.elapsed().as_secs_f64();
     Ok(modes)
 }
@@ -1044,6 +1088,9 @@ impl<'a> BandRun<'a> {
             );
             self.lambda.push(l);
             self.vectors.push(if e2 < e1 { u2 } else { u1 });
+        }
+        if self.lambda.len() > self.params.max_modes {
+            return Err(crate::eigen::too_many_modes(self.params));
         }
         Ok(())
     }
@@ -1441,6 +1488,10 @@ pub fn band_pairs(lambda: &[c64], params: &EigenParams) -> Vec<(f64, usize)> {
 /// at the band does not see them. The band is inclusive with a relative slack of
 /// `1e-12`. Vectors get unit 2-norm and a deterministic phase (their largest-modulus
 /// component real positive). `info` is passed through (the caller sets `time_s`).
+///
+/// Left eigenvectors, condition numbers and forward error estimates are computed as
+/// [`Condition::Auto`] says (by inverse iteration on `qep`, one factorization per kept
+/// mode, counted in `info.factorizations` and noted).
 pub fn finish_modes(
     qep: &Qep,
     lambda: &[c64],
@@ -1448,12 +1499,30 @@ pub fn finish_modes(
     params: &EigenParams,
     info: SolveInfo,
 ) -> Result<ComplexModes> {
-    finish_terms(&QepTerms::of_qep(qep), lambda, vectors, params, info)
+    finish_modes_with(qep, lambda, vectors, params, info, Condition::Auto)
+}
+
+/// [`finish_modes`] with an explicit choice of left eigenvectors.
+pub fn finish_modes_with(
+    qep: &Qep,
+    lambda: &[c64],
+    vectors: faer::MatRef<'_, c64>,
+    params: &EigenParams,
+    info: SolveInfo,
+    condition: Condition,
+) -> Result<ComplexModes> {
+    let left = if condition.applies(qep.dim()) {
+        LeftSource::InverseIteration(qep)
+    } else {
+        LeftSource::None
+    };
+    finish_terms(&QepTerms::of_qep(qep), lambda, vectors, left, params, info)
 }
 
 /// [`finish_modes`] on `op.at(mu)`, without assembling it: the backward errors are
-/// computed on the parts `X_c - mu F_X` (the same numbers to round-off). Reduced solves
-/// use it once per mu.
+/// computed on the parts `X_c - mu F_X` (the same numbers to round-off). No left
+/// eigenvectors (`cond` and `error_bound` are NaN); reduced solves use
+/// [`finish_operator_modes_with_left`].
 pub fn finish_operator_modes(
     op: &FrictionalOperator,
     mu: f64,
@@ -1469,17 +1538,109 @@ pub fn finish_operator_modes(
         &QepTerms::of_operator(op, mu),
         lambda,
         vectors,
+        LeftSource::None,
         params,
         info,
     )
+}
+
+/// [`finish_operator_modes`] with given left eigenvectors (one column per eigenvalue of
+/// `lambda`, e.g. a reduced solve's left vectors expanded by the basis), from which the
+/// condition numbers and forward error estimates are computed on `op.at(mu)`.
+pub fn finish_operator_modes_with_left(
+    op: &FrictionalOperator,
+    mu: f64,
+    lambda: &[c64],
+    vectors: faer::MatRef<'_, c64>,
+    left: faer::MatRef<'_, c64>,
+    params: &EigenParams,
+    info: SolveInfo,
+) -> Result<ComplexModes> {
+    if !mu.is_finite() {
+        return Err(Error::param("mu", format!("must be finite, got {mu}")));
+    }
+    if left.nrows() != op.dim() || left.ncols() != lambda.len() {
+        return Err(Error::Dimension {
+            context: "finish_modes: one left vector of the operator size per eigenvalue".into(),
+            expected: lambda.len(),
+            got: left.ncols(),
+        });
+    }
+    finish_terms(
+        &QepTerms::of_operator(op, mu),
+        lambda,
+        vectors,
+        LeftSource::Given(left),
+        params,
+        info,
+    )
+}
+
+/// Adds left eigenvectors, condition numbers and forward error estimates to modes of
+/// `op` at `mu` that were computed without them (a full-order solve above
+/// [`CONDITION_AUTO_MAX_DIM`], where
+/// [`Condition::Auto`] skips them): the left vectors by [`left_eigenvectors`] on
+/// `op.at(mu)` (one factorization of `Q(lambda)` per mode), then `cond` and
+/// `error_bound` from the modes' own backward errors. Modes that already carry left
+/// vectors are left as they are. The factorizations are counted in `info` and noted with
+/// their time; `info.time_s` is not changed.
+///
+/// # Errors
+/// A non-finite `mu`, modes whose vectors do not have the operator's size, or a failure
+/// of the left solves.
+pub fn add_condition(op: &FrictionalOperator, mu: f64, modes: &mut ComplexModes) -> Result<()> {
+    if modes.left_vectors.is_some() {
+        return Ok(());
+    }
+    if !mu.is_finite() {
+        return Err(Error::param("mu", format!("must be finite, got {mu}")));
+    }
+    if modes.vectors.nrows() != op.dim() || modes.vectors.ncols() != modes.len() {
+        return Err(Error::Dimension {
+            context: "add_condition: one mode vector of the operator size per eigenvalue".into(),
+            expected: op.dim(),
+            got: modes.vectors.nrows(),
+        });
+    }
+    let t = Instant::now();
+    let qep = op.at(mu)?;
+    let (y, how) = left_eigenvectors(&qep, &modes.lambda, modes.vectors.as_ref())?;
+    let terms = QepTerms::of_operator(op, mu);
+    let (cond, error_bound) = condition::condition_numbers(
+        &terms,
+        &terms.norms(),
+        &modes.lambda,
+        modes.vectors.as_ref(),
+        y.as_ref(),
+        &modes.backward_error,
+    );
+    modes.info.factorizations += how.factorizations;
+    if !modes.is_empty() {
+        modes.info.notes.push(format!(
+            "left eigenvectors for cond, error_bound (asked for): {}{} factorizations of \
+             Q(lambda), {:.3} s",
+            if how.transposed_solve {
+                "one dense solve of the transposed problem, "
+            } else {
+                ""
+            },
+            how.factorizations,
+            t.elapsed().as_secs_f64()
+        ));
+    }
+    modes.cond = cond;
+    modes.error_bound = error_bound;
+    modes.left_vectors = Some(y);
+    Ok(())
 }
 
 fn finish_terms(
     qep: &QepTerms<'_>,
     lambda: &[c64],
     vectors: faer::MatRef<'_, c64>,
+    left: LeftSource<'_>,
     params: &EigenParams,
-    info: SolveInfo,
+    mut info: SolveInfo,
 ) -> Result<ComplexModes> {
     let n = qep.n;
     if vectors.nrows() != n {
@@ -1524,12 +1685,42 @@ fn finish_terms(
         dvr.push(l.re / l.im);
     }
     let be = backward_errors(qep, &norms, &lam, out.as_ref());
+    let left = match left {
+        LeftSource::None => None,
+        LeftSource::Given(y) => Some(Mat::from_fn(n, keep.len(), |r, c| y[(r, keep[c].1)])),
+        LeftSource::InverseIteration(q) => {
+            let t = Instant::now();
+            let (y, how) = left_eigenvectors(q, &lam, out.as_ref())?;
+            info.factorizations += how.factorizations;
+            if !lam.is_empty() {
+                info.notes.push(format!(
+                    "left eigenvectors for cond, error_bound: {}{} factorizations of \
+                     Q(lambda) for inverse iteration, {:.3} s",
+                    if how.transposed_solve {
+                        "one dense solve of the transposed problem, "
+                    } else {
+                        ""
+                    },
+                    how.factorizations,
+                    t.elapsed().as_secs_f64()
+                ));
+            }
+            Some(y)
+        }
+    };
+    let (cond, error_bound) = match &left {
+        Some(y) => condition::condition_numbers(qep, &norms, &lam, out.as_ref(), y.as_ref(), &be),
+        None => (vec![f64::NAN; lam.len()], vec![f64::NAN; lam.len()]),
+    };
     Ok(ComplexModes {
         lambda: lam,
         vectors: out,
         freq_hz: freq,
         dvr,
         backward_error: be,
+        cond,
+        error_bound,
+        left_vectors: left,
         info,
     })
 }

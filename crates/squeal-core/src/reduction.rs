@@ -30,13 +30,19 @@
 //! parts have `4 nA` nonzero rows, so their projection is cheap), a dense-backed
 //! [`FrictionalOperator`] with `t: None`, solved by any [`EigenSolver`] (normally `dense`)
 //! at each mu; the modes `u_c = V q` are finished by [`finish_operator_modes`] on the
-//! parts of `op.at(mu)`, so their backward errors are those of the full problem.
+//! parts of `op.at(mu)`, so their backward errors are those of the full problem. When the
+//! reduced solver returns left eigenvectors `p`, they are expanded the same way
+//! (`y = V p`) and give each mode a condition number and a forward error estimate on the
+//! full problem ([`finish_operator_modes_with_left`]; see the `qep::condition` module
+//! docs for the limits of this Galerkin left vector).
 
 use crate::contact::{Basis, BasisRequest, FrictionalOperator};
 use crate::eigen::{EigenParams, EigenSolver, RealModes, SymmetricProblem};
 pub use crate::linalg::sparse_times;
 use crate::linalg::{add_scaled, dot, spmv, Cholesky};
-use crate::qep::{finish_operator_modes, spmv_complex, ComplexModes};
+use crate::qep::{
+    finish_operator_modes, finish_operator_modes_with_left, spmv_complex, ComplexModes,
+};
 use crate::{c64, Error, Result, SparseMat, SparseRef};
 use faer::linalg::matmul::matmul;
 use faer::sparse::Triplet;
@@ -468,7 +474,22 @@ impl ReducedOperator {
             self.basis.iterations
         ));
         info.notes.extend(self.basis.notes.iter().cloned());
-        let mut modes = finish_operator_modes(op, mu, &lambda, u.as_ref(), params, info)?;
+        let mut modes = match &red.left_vectors {
+            Some(p) => {
+                let pk = Mat::from_fn(p.nrows(), kept.len(), |i, j| p[(i, kept[j])]);
+                let y = expand(self.basis.v.as_ref(), pk.as_ref());
+                finish_operator_modes_with_left(
+                    op,
+                    mu,
+                    &lambda,
+                    u.as_ref(),
+                    y.as_ref(),
+                    params,
+                    info,
+                )?
+            }
+            None => finish_operator_modes(op, mu, &lambda, u.as_ref(), params, info)?,
+        };
         let expansion_time_s = start.elapsed().as_secs_f64();
         modes.info.time_s = solve_time_s + expansion_time_s;
         Ok(ReducedSolve {

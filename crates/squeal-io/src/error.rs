@@ -167,6 +167,32 @@ pub enum IoError {
         /// What squeal reads.
         expected: String,
     },
+    /// A MAT-file that is not a readable Level 5 file, or a variable in it that is not a
+    /// real 2-D matrix.
+    #[error("{}{}: {problem}; expected {expected}", file.display(), in_variable(variable))]
+    Mat {
+        /// The file.
+        file: PathBuf,
+        /// The variable; `None` for a defect of the whole file.
+        variable: Option<String>,
+        /// What is wrong.
+        problem: String,
+        /// What squeal reads.
+        expected: String,
+    },
+    /// A parametric operator description (`operator.toml`) that is invalid, or a value of
+    /// its parameter at which the operator cannot be formed.
+    #[error("{}: {field}: {problem}; expected {expected}", file.display())]
+    Parametric {
+        /// The description file (or the directory).
+        file: PathBuf,
+        /// The key, term or part concerned (`K[2].coeff`, `parameter`, `M`, ...).
+        field: String,
+        /// What is wrong.
+        problem: String,
+        /// What would be valid.
+        expected: String,
+    },
     /// Operator metadata that cannot be written faithfully (e.g. a non-finite mu).
     #[error("{}: {problem}", file.display())]
     Meta {
@@ -175,6 +201,13 @@ pub enum IoError {
         /// What is wrong.
         problem: String,
     },
+}
+
+/// `" (variable `name`)"`, or nothing.
+fn in_variable(v: &Option<String>) -> String {
+    v.as_ref()
+        .map(|v| format!(" (variable `{v}`)"))
+        .unwrap_or_default()
 }
 
 /// `":<line>"`, or nothing.

@@ -507,6 +507,19 @@ pub fn read_msh_bytes(bytes: &[u8], file: &Path) -> Result<Mesh, IoError> {
             if vol < 0.0 {
                 h = [h[0], h[3], h[2], h[1], h[4], h[7], h[6], h[5]];
             }
+            // a repeated node (an edge of zero length) or an inverted corner leaves the
+            // volume non-zero but the element unusable
+            let q = squeal_fe::hex8::scaled_jacobian(&h.map(|n| mesh.nodes[n]));
+            if q <= 0.0 {
+                return Err(p.err(
+                    Some(*line),
+                    format!(
+                        "hexahedron {etag} has a repeated node or an inverted corner \
+                         (scaled Jacobian {q:.3})"
+                    ),
+                    "hexahedra whose eight corners are distinct and convex",
+                ));
+            }
             mesh.hexes.push(h);
         }
     }

@@ -13,6 +13,12 @@
 //!
 //! - [`read_msh`], [`write_msh`]: Gmsh MSH 4.1 ASCII meshes of 8-node hexahedra, physical
 //!   groups becoming named node sets (see [`gmsh`]).
+//! - [`read_mat`], [`MatFile`]: real sparse and dense matrices of MATLAB Level 5 MAT-files
+//!   (`save -v7`, `scipy.io.savemat`), compressed or not (see [`mat`]).
+//! - [`ParametricOperator`]: an operator directory whose `operator.toml` defines `M`, `C`,
+//!   `K` and the friction parts as sums of `.mtx`/`.mat` components with coefficients
+//!   that are formulas of one parameter ([`expr`]); `.at(value)` gives the
+//!   [`squeal_core::FrictionalOperator`] (format in `docs/operators.md`).
 //!
 //! Every error ([`IoError`]) names the file, the line where one applies, and what was
 //! expected. Units are SI (kg, N s/m, N/m).
@@ -23,14 +29,19 @@
 #![doc(html_no_source)]
 
 mod error;
+pub mod expr;
 pub mod gmsh;
+pub mod mat;
 mod mtx;
 mod operator;
+pub mod parametric;
 
 pub use error::IoError;
 pub use gmsh::{msh_string, read_msh, read_msh_bytes, write_msh, VOLUME_GROUP};
+pub use mat::{read_mat, MatFile};
 pub use mtx::{read_mtx, read_mtx_from, read_square_mtx, write_mtx, write_mtx_to};
 pub use operator::{
     read_index_map, read_operator_dir, write_index_map, write_operator_dir, OperatorMeta, FILE_CC,
     FILE_FC, FILE_FK, FILE_FM, FILE_KC, FILE_MC, FILE_META, FILE_README, FILE_T,
 };
+pub use parametric::{ParametricOperator, PARAMETRIC_FORMAT};

@@ -285,6 +285,13 @@ fn truncated_and_malformed_files_are_rejected() {
         &flat,
         &["flat.msh:49:", "hexahedron 3 is degenerate"],
     );
+    // a repeated node: the element keeps a volume but a corner collapses
+    let wedge = ONE_HEX.replace("3 10 20 30 40 50 60 70 80", "3 10 20 30 40 50 60 70 50");
+    fails(
+        "wedge.msh",
+        &wedge,
+        &["wedge.msh:49:", "hexahedron 3 has a repeated node"],
+    );
 }
 
 #[test]

@@ -231,8 +231,9 @@ pub(crate) fn render(stem: &Path, fig: &impl Figure) -> Result<Vec<PathBuf>, Plo
 // ---------------------------------------------------------------------------------------
 // Shared styling helpers.
 
-/// Qualitative palette for series (tab10 without its red, which marks highlights).
-pub(crate) const PALETTE: [RGBColor; 9] = [
+/// Qualitative palette for series: tab10 without its red (which marks highlights), then
+/// the light tab20 partners of those nine, so up to 18 series get distinct colours.
+pub(crate) const PALETTE: [RGBColor; 18] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
@@ -242,6 +243,15 @@ pub(crate) const PALETTE: [RGBColor; 9] = [
     RGBColor(127, 127, 127),
     RGBColor(188, 189, 34),
     RGBColor(23, 190, 207),
+    RGBColor(174, 199, 232),
+    RGBColor(255, 187, 120),
+    RGBColor(152, 223, 138),
+    RGBColor(197, 176, 213),
+    RGBColor(196, 156, 148),
+    RGBColor(247, 182, 210),
+    RGBColor(199, 199, 199),
+    RGBColor(219, 219, 141),
+    RGBColor(158, 218, 229),
 ];
 
 /// Colour of highlighted points (unstable modes, Pareto front).
@@ -281,6 +291,20 @@ pub(crate) fn fmt_tick(v: &f64) -> String {
             "0".into()
         } else {
             s.to_string()
+        }
+    }
+}
+
+/// [`fmt_tick`] for an axis spanning `range`: on a linear axis a tick that is zero to
+/// round-off of the span (a linear axis through 0 computes its 0 tick as 6.9e-18) reads
+/// `0`; a logarithmic axis keeps its small values.
+pub(crate) fn tick_in(range: &Range<f64>, log: bool) -> impl Fn(&f64) -> String {
+    let span = (range.end - range.start).abs();
+    move |v: &f64| {
+        if !log && v.abs() <= 1e-9 * span {
+            "0".into()
+        } else {
+            fmt_tick(v)
         }
     }
 }
@@ -385,6 +409,11 @@ mod tests {
         assert_eq!(fmt_tick(&1e-6), "1e-6");
         assert_eq!(fmt_tick(&2.5e6), "2.5e6");
         assert_eq!(fmt_tick(&-1e-12), "-1e-12");
+        // a zero tick computed to round-off reads 0 on a linear axis
+        let t = tick_in(&(-0.05..0.05), false);
+        assert_eq!(t(&6.94e-18), "0");
+        assert_eq!(t(&0.01), "0.01");
+        assert_eq!(tick_in(&(1e-12..1e-2), true)(&1e-12), "1e-12");
     }
 
     #[test]

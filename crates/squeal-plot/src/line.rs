@@ -8,7 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::{
-    auto_linear, auto_log, check_range, fmt_tick, font, render, title_font, with_axes, Figure,
+    auto_linear, auto_log, check_range, font, render, tick_in, title_font, with_axes, Figure,
     PlotError, CHART_SIZE, HIGHLIGHT, PALETTE,
 };
 
@@ -236,8 +236,8 @@ impl LineFig<'_> {
             .configure_mesh()
             .x_desc(self.x_label)
             .y_desc(self.y_label)
-            .x_label_formatter(&fmt_tick)
-            .y_label_formatter(&fmt_tick)
+            .x_label_formatter(&tick_in(&self.xr, self.opts.log_x))
+            .y_label_formatter(&tick_in(&self.yr, self.opts.log_y))
             .label_style(font(14))
             .axis_desc_style(font(16))
             .draw()?;

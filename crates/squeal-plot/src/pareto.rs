@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::{auto_log, fmt_tick, font, render, title_font, Figure, PlotError, CHART_SIZE};
 use crate::{HIGHLIGHT, PALETTE};
@@ -46,9 +45,9 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
 /// [`CHART_SIZE`]).
 ///
 /// `points` are `(label, x, y)` per method, typically `(name, time in s, error)`; both are
-/// minimised. Every point is drawn as a circle with its label next to it; the Pareto
-/// front ([`pareto_front`]) is drawn in red, joined by a line in order of x, and named in
-/// the legend. Points with a non-positive coordinate cannot appear on log axes and are
+/// minimised. Every point is a circle of its own colour named in the legend (no text on
+/// the plot area, so clustered methods stay readable); the Pareto front
+/// ([`pareto_front`]) is a red line through red rings around its points, in order of x. Points with a non-positive coordinate cannot appear on log axes and are
 /// dropped (also from the front).
 ///
 /// # Errors
@@ -142,39 +141,36 @@ impl Figure for ParetoFig<'_> {
             .axis_desc_style(font(16))
             .draw()?;
 
-        let on_front = |i: usize| self.front.contains(&i);
-        let base = PALETTE[0];
+        // every method its own colour and legend entry (no text next to the points,
+        // which piles up where methods cluster); the front is a red line through red
+        // rings around its points
         if self.front.len() >= 2 {
-            chart.draw_series(LineSeries::new(
-                self.front
-                    .iter()
-                    .map(|&i| (self.points[i].1, self.points[i].2)),
+            chart
+                .draw_series(LineSeries::new(
+                    self.front
+                        .iter()
+                        .map(|&i| (self.points[i].1, self.points[i].2)),
+                    HIGHLIGHT.stroke_width(2),
+                ))?
+                .label("Pareto front")
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 14, y)], HIGHLIGHT.stroke_width(2))
+                });
+        }
+        chart.draw_series(self.front.iter().map(|&i| {
+            Circle::new(
+                (self.points[i].1, self.points[i].2),
+                9,
                 HIGHLIGHT.stroke_width(2),
-            ))?;
-        }
-        let ann = chart.draw_series(
-            (0..self.points.len())
-                .filter(|&i| !on_front(i))
-                .map(|i| Circle::new((self.points[i].1, self.points[i].2), 5, base.filled())),
-        )?;
-        if self.front.len() < self.points.len() {
-            ann.label("dominated")
-                .legend(move |(x, y)| Circle::new((x + 7, y), 5, base.filled()));
-        }
-        chart
-            .draw_series(self.front.iter().map(|&i| {
-                Circle::new((self.points[i].1, self.points[i].2), 6, HIGHLIGHT.filled())
-            }))?
-            .label("Pareto front")
-            .legend(|(x, y)| Circle::new((x + 7, y), 6, HIGHLIGHT.filled()));
-        chart.draw_series(self.points.iter().map(|(l, x, y)| {
-            EmptyElement::at((*x, *y))
-                + Text::new(
-                    l.clone(),
-                    (9, -4),
-                    font(14).pos(Pos::new(HPos::Left, VPos::Bottom)),
-                )
+            )
         }))?;
+        for (k, (label, x, y)) in self.points.iter().enumerate() {
+            let color = PALETTE[k % PALETTE.len()];
+            chart
+                .draw_series(std::iter::once(Circle::new((*x, *y), 6, color.filled())))?
+                .label(label.clone())
+                .legend(move |(x, y)| Circle::new((x + 7, y), 6, color.filled()));
+        }
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperRight)

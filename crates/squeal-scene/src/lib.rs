@@ -5,6 +5,7 @@
 //! [`Scene::builtin`] gives the embedded default `pin-on-disc`; [`build`] turns a scene
 //! into the smallest FE model that resolves its frequency band.
 
+mod edit;
 mod model;
 mod spec;
 
@@ -12,8 +13,8 @@ pub use model::{
     build, element_size, line_cells, BodyKind, BodyStats, ContactGrid, Model, SizeRule,
 };
 pub use spec::{
-    ContactRefinement, ContactSpec, Damping, Disc, Flange, Hat, ImportedMesh, Load, MaterialSpec,
-    MeshImport, MeshRule, Pin, Plate, Scene, Study, Zone, BUILTIN_SCENES,
+    Clamp, ContactRefinement, ContactSpec, Damping, Disc, Flange, Hat, ImportedMesh, Load,
+    MaterialSpec, MeshImport, MeshRule, Pin, Plate, Scene, Study, Zone, BUILTIN_SCENES,
 };
 
 use thiserror::Error;

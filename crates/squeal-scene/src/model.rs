@@ -312,6 +312,53 @@ fn contact_grid(
     Ok(grid)
 }
 
+/// The node count of a build, checked before each block of nodes is made.
+struct NodeBudget {
+    max_dofs: usize,
+    parts: Vec<(&'static str, usize)>,
+}
+
+impl NodeBudget {
+    fn new(max_dofs: usize) -> Self {
+        Self {
+            max_dofs,
+            parts: Vec::new(),
+        }
+    }
+
+    /// Accounts for a block of `dims` nodes of `what`; refuses the build when the total
+    /// passes the budget.
+    fn take(&mut self, what: &'static str, dims: &[usize], file: &str) -> Result<()> {
+        let n = dims.iter().fold(1usize, |a, &d| a.saturating_mul(d));
+        self.parts.push((what, n));
+        let total: usize = self
+            .parts
+            .iter()
+            .map(|p| p.1)
+            .fold(0, usize::saturating_add);
+        if total.saturating_mul(3) > self.max_dofs {
+            let list: Vec<String> = self
+                .parts
+                .iter()
+                .map(|(w, n)| format!("{w} {}", n.saturating_mul(3)))
+                .collect();
+            return Err(SceneError::Field {
+                file: file.into(),
+                field: "mesh.max_dofs".into(),
+                message: format!(
+                    "the mesh rule asks for more than {} DOFs ({} so far); expected at most \
+                     mesh.max_dofs = {}: check mesh.max_freq_hz and the element counts, or \
+                     raise mesh.max_dofs for a deliberately large model",
+                    total.saturating_mul(3),
+                    list.join(", "),
+                    self.max_dofs
+                ),
+            });
+        }
+        Ok(())
+    }
+}
+
 /// Appends an imported body mesh as body `body` (node sets prefixed `prefix`) and fixes
 /// the nodes of its `fixed_groups`; an unknown group is an error message.
 fn append_imported(
@@ -683,6 +730,7 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
         message: "this body is asked for but the scene has no such table".into(),
     };
     let mut mesh = Mesh::default();
+    let mut budget = NodeBudget::new(rule.max_dofs);
     let mut materials: Vec<Box<dyn Material>> = Vec::new();
     let mut body_names = Vec::new();
     let mut sizes = Vec::new();
@@ -893,11 +941,13 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             None => [r * th.cos(), r * th.sin()],
         };
         let nt = thetas.len();
+        budget.take("disc", &[rs.len(), thetas.len(), zs.len()], file)?;
         let ring = Mesh::annulus_mapped(&rs, &thetas, &zs, &xy_map).with_body(body);
         let map = mesh.append(&ring, "disc.", None);
         if let (Some((fp, t)), Some(pa)) = (&fine, &patch) {
             // the disc's contact layer on the ring's top under the pin face, its bottom
             // tied to the ring's patch grid
+            budget.take("disc contact layer", &[fp.xs.len(), fp.ys.len(), 2], file)?;
             let layer = Mesh::block(&fp.xs, &fp.ys, &[0.0, *t]).with_body(body);
             let (layer_ties, rule) =
                 contact_layer(&mut mesh, &layer, "disc", "zmin", "zmax", pa, fp, 1)
@@ -911,6 +961,7 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             (Some(hat), Some((lw, hw, _))) => {
                 let nzh = ((hat.height_m / hw.min(h)).ceil() as usize).max(rule.min_layers);
                 let wall_rs = within(&rs, r_in_wall, r_wall);
+                budget.take("disc hat", &[wall_rs.len(), thetas.len(), nzh + 1], file)?;
                 let hat_mesh = Mesh::annulus_mapped(
                     &wall_rs,
                     &thetas,
@@ -934,6 +985,7 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
                         let mut frs = graded(&[fl.inner_radius_m, r_in_wall], &|_, _| hf.min(h));
                         frs.extend(wall_rs.iter().skip(1));
                         let nzf = ((fl.thickness_m / hf).ceil() as usize).max(rule.min_layers);
+                        budget.take("disc flange", &[frs.len(), thetas.len(), nzf + 1], file)?;
                         let flange = Mesh::annulus_mapped(
                             &frs,
                             &thetas,
@@ -1080,6 +1132,7 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
         let nzp = zp.len() - 1;
         match &fine {
             None => {
+                budget.take("pin", &[pa.xs.len(), pa.ys.len(), zp.len()], file)?;
                 let pin = Mesh::block(&pa.xs, &pa.ys, &zp).with_body(materials.len());
                 mesh.append(&pin, "pin.", None);
             }
@@ -1094,9 +1147,15 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
                     )));
                 }
                 let up: Vec<f64> = zp[1..].iter().map(|z| z + lift).collect();
+                let nl = (zp[1] / (2.0 * t) - 1e-9).ceil().max(1.0) as usize;
+                budget.take("pin", &[pa.xs.len(), pa.ys.len(), up.len()], file)?;
+                budget.take(
+                    "pin contact layer",
+                    &[fp.xs.len(), fp.ys.len(), nl + 1],
+                    file,
+                )?;
                 let pin = Mesh::block(&pa.xs, &pa.ys, &up).with_body(materials.len());
                 mesh.append(&pin, "pin.", None);
-                let nl = (zp[1] / (2.0 * t) - 1e-9).ceil().max(1.0) as usize;
                 let layer = Mesh::block(
                     &fp.xs,
                     &fp.ys,
@@ -1127,6 +1186,15 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
             let nz = ((pl.thickness_m / h).ceil() as usize).max(rule.min_layers);
             let xs_p = within(&xs, -pl.length_x_m / 2.0, pl.length_x_m / 2.0);
             let ys_p = within(&ys, yc - pl.width_y_m / 2.0, yc + pl.width_y_m / 2.0);
+            budget.take(
+                if *name == "thin_plate" {
+                    "thin plate"
+                } else {
+                    "thick plate"
+                },
+                &[xs_p.len(), ys_p.len(), nz + 1],
+                file,
+            )?;
             let block = Mesh::block(
                 &xs_p,
                 &ys_p,
@@ -1139,7 +1207,7 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
                 Some(1e-9 * (1.0 + pl.length_x_m)),
             );
             if *name == "thin_plate" {
-                for set in ["xmin", "xmax"] {
+                for set in pl.clamp.unwrap_or_default().node_sets() {
                     fixed_nodes.extend(block.node_set(set).unwrap().iter().map(|&n| map[n]));
                 }
             }

@@ -273,14 +273,42 @@ pub struct Pin {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Plate {
-    /// Length along x (m); the thin plate is fixed at both x ends.
+    /// Length along x (m).
     pub length_x_m: f64,
     /// Width along y (m).
     pub width_y_m: f64,
     /// Thickness (m).
     pub thickness_m: f64,
+    /// Which pair of edges of the thin plate is fixed (the thick plate is not fixed:
+    /// `None` there); `None` on the thin plate means the two x ends.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clamp: Option<Clamp>,
     /// Material.
     pub material: MaterialSpec,
+}
+
+/// The fixed edges of the thin plate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Clamp {
+    /// The two ends across x (x = +-length_x / 2): the plate bends along x.
+    #[default]
+    X,
+    /// The two edges across y (y = centre +- width_y / 2): the plate bends along y.
+    Y,
+    /// All four edges.
+    Xy,
+}
+
+impl Clamp {
+    /// The node sets of a generated block that this clamp fixes.
+    pub fn node_sets(self) -> &'static [&'static str] {
+        match self {
+            Clamp::X => &["xmin", "xmax"],
+            Clamp::Y => &["ymin", "ymax"],
+            Clamp::Xy => &["xmin", "xmax", "ymin", "ymax"],
+        }
+    }
 }
 
 /// How element sizes follow from the frequency band.
@@ -306,6 +334,10 @@ pub struct MeshRule {
     /// thin contact layers tied to the coarse bodies (see [`ContactRefinement`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact_refinement: Option<ContactRefinement>,
+    /// Most DOFs (3 per node) a build may reach: the meshes are counted before any is
+    /// made, and a rule that asks for more is refused with its count (a typing error in
+    /// `max_freq_hz` must not fill the memory). Raise it for a deliberately large model.
+    pub max_dofs: usize,
 }
 
 /// Contact refinement: the contact grid gets lines every `element_m` or less inside
@@ -334,6 +366,7 @@ impl Default for MeshRule {
             pin_face_elements: 20,
             grading_ratio: 1.25,
             contact_refinement: None,
+            max_dofs: 2_000_000,
         }
     }
 }
@@ -544,7 +577,9 @@ impl Default for Load {
 pub struct Study {
     /// Coulomb friction coefficient.
     pub mu: f64,
-    /// Frequency band of the stability analysis (Hz).
+    /// Frequency band of the stability analysis (Hz): every command's default `--band`.
+    /// Default 0-5 kHz, where the paper's couplings lie; the mesh resolves up to
+    /// `mesh.max_freq_hz`.
     pub band_hz: [f64; 2],
     /// Rotation sense of the disc about +z: `1` counter-clockwise, `-1` clockwise.
     pub rotation: f64,
@@ -554,7 +589,7 @@ impl Default for Study {
     fn default() -> Self {
         Self {
             mu: 0.3,
-            band_hz: [0.0, 10_000.0],
+            band_hz: [0.0, 5_000.0],
             rotation: 1.0,
         }
     }
@@ -821,6 +856,15 @@ impl Scene {
         if let Some(d) = &self.disc {
             positive("disc.inner_radius_m", d.inner_radius_m)?;
             positive("disc.outer_radius_m", d.outer_radius_m)?;
+            if d.inner_radius_m >= d.outer_radius_m {
+                return Err(field(
+                    "disc.inner_radius_m",
+                    format!(
+                        "{} m: expected less than disc.outer_radius_m = {} m",
+                        d.inner_radius_m, d.outer_radius_m
+                    ),
+                ));
+            }
             positive("disc.thickness_m", d.thickness_m)?;
             if let Some(hat) = &d.hat {
                 positive("disc.hat.height_m", hat.height_m)?;
@@ -906,6 +950,12 @@ impl Scene {
                 positive(&format!("{name}.length_x_m"), pl.length_x_m)?;
                 positive(&format!("{name}.width_y_m"), pl.width_y_m)?;
                 positive(&format!("{name}.thickness_m"), pl.thickness_m)?;
+                if name == "thick_plate" && pl.clamp.is_some() {
+                    return Err(field(
+                        "thick_plate.clamp",
+                        "only the thin plate is fixed: remove `clamp` from [thick_plate]".into(),
+                    ));
+                }
                 if let Some(p) = &self.pin {
                     if pl.length_x_m < p.size_x_m || pl.width_y_m < p.size_y_m {
                         return Err(field(
@@ -952,10 +1002,22 @@ impl Scene {
                 ));
             }
         }
-        if m.min_layers == 0 || m.pin_face_elements == 0 {
+        if m.max_dofs == 0 {
+            return Err(field(
+                "mesh.max_dofs",
+                "expected a positive number of DOFs (default 2000000)".into(),
+            ));
+        }
+        if m.min_layers == 0 {
             return Err(field(
                 "mesh.min_layers",
-                "expected at least 1 layer and 1 pin face element".into(),
+                "expected at least 1 element layer through every thickness".into(),
+            ));
+        }
+        if m.pin_face_elements == 0 {
+            return Err(field(
+                "mesh.pin_face_elements",
+                "expected at least 1 element along each side of the pin face".into(),
             ));
         }
         if let Some(r) = &m.contact_refinement {

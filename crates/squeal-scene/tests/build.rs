@@ -56,10 +56,48 @@ fn pin_stack_is_glued_and_fixed_at_the_plate_ends() {
     assert!(pin_top
         .iter()
         .all(|n| plate_bottom.binary_search(n).is_ok()));
-    let ends = model.mesh.node_set("thin_plate.xmin").unwrap();
-    for &n in ends {
-        assert!(model.dofs.free_of_full[3 * n].is_none());
+    // the clamped edges (the default clamps the two radial ends, y) are fixed, the others
+    // free
+    let clamp = scene.thin_plate.as_ref().unwrap().clamp.unwrap_or_default();
+    assert_eq!(clamp, squeal_scene::Clamp::Y);
+    for set in ["xmin", "xmax", "ymin", "ymax"] {
+        let nodes = model.mesh.node_set(&format!("thin_plate.{set}")).unwrap();
+        let fixed = clamp.node_sets().contains(&set);
+        // nodes of this edge alone (not a corner shared with a clamped edge)
+        let clamped: Vec<usize> = clamp
+            .node_sets()
+            .iter()
+            .flat_map(|c| {
+                model
+                    .mesh
+                    .node_set(&format!("thin_plate.{c}"))
+                    .unwrap()
+                    .to_vec()
+            })
+            .collect();
+        let plate_only: Vec<usize> = nodes
+            .iter()
+            .copied()
+            .filter(|n| fixed || !clamped.contains(n))
+            .collect();
+        assert!(!plate_only.is_empty());
+        for &n in &plate_only {
+            assert_eq!(
+                model.dofs.free_of_full[3 * n].is_none(),
+                fixed,
+                "thin_plate.{set}: node {n} fixed = {}",
+                !fixed
+            );
+        }
     }
+    // the other orientation fixes the x ends instead
+    let mut x = scene.clone();
+    x.thin_plate.as_mut().unwrap().clamp = Some(squeal_scene::Clamp::X);
+    let mx = build(&x, BodyKind::Pin, &registry(), "x").unwrap();
+    let xmin = mx.mesh.node_set("thin_plate.xmin").unwrap();
+    assert!(xmin.iter().all(|&n| mx.dofs.free_of_full[3 * n].is_none()));
+    let ymin = mx.mesh.node_set("thin_plate.ymin").unwrap();
+    assert!(ymin.iter().any(|&n| mx.dofs.free_of_full[3 * n].is_some()));
     let p = scene.pin.as_ref().unwrap();
     let pin_nodes = model.mesh.body_nodes(0);
     let face = pin_nodes

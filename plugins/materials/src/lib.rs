@@ -25,7 +25,7 @@ pub use isotropic::{isotropic_elasticity, Isotropic};
 pub use transverse::{huber_shear_modulus, TransverselyIsotropic};
 pub use voigt::{bond_stress_matrix, frame_with_axis, rotate_elasticity};
 
-use squeal_core::{Error, Registry};
+use squeal_core::{Error, Material, Registry};
 
 /// Registers `"isotropic"` and `"transversely_isotropic"` into `reg.materials`.
 ///
@@ -46,11 +46,13 @@ pub fn register(reg: &mut Registry) {
                 "isotropic",
                 &["youngs_modulus_pa", "poisson_ratio", "density_kg_m3"],
             )?;
-            Ok(Box::new(Isotropic::new(
+            Isotropic::new(
                 p.num("youngs_modulus_pa")?,
                 p.num("poisson_ratio")?,
                 p.num("density_kg_m3")?,
-            )?))
+            )
+            .map(|m| Box::new(m) as Box<dyn Material>)
+            .map_err(scene_names)
         },
     );
     reg.materials.register(
@@ -82,7 +84,7 @@ pub fn register(reg: &mut Registry) {
                     format!("expected a list of 3 numbers, got {} numbers", axis.len()),
                 )
             })?;
-            Ok(Box::new(TransverselyIsotropic::new(
+            TransverselyIsotropic::new(
                 p.num("youngs_modulus_in_plane_pa")?,
                 p.num("youngs_modulus_axial_pa")?,
                 p.num("poisson_ratio_in_plane")?,
@@ -90,9 +92,43 @@ pub fn register(reg: &mut Registry) {
                 g,
                 axis,
                 p.num("density_kg_m3")?,
-            )?))
+            )
+            .map(|m| Box::new(m) as Box<dyn Material>)
+            .map_err(scene_names)
         },
     );
+}
+
+/// A material error with the constant named as the scene writes it
+/// (`shear_modulus_axial_pa`, not the law's symbol `g_axial`).
+fn scene_names(e: Error) -> Error {
+    match e {
+        Error::Material {
+            material,
+            field,
+            value,
+            expected,
+        } => {
+            let field = match field.as_str() {
+                "youngs_modulus" => "youngs_modulus_pa",
+                "density" => "density_kg_m3",
+                "e_in_plane" => "youngs_modulus_in_plane_pa",
+                "e_axial" => "youngs_modulus_axial_pa",
+                "g_axial" => "shear_modulus_axial_pa",
+                "nu_in_plane" => "poisson_ratio_in_plane",
+                "nu_axial" => "poisson_ratio_axial",
+                other => other,
+            }
+            .to_string();
+            Error::Material {
+                material,
+                field,
+                value,
+                expected,
+            }
+        }
+        other => other,
+    }
 }
 
 /// A [`squeal_core::Error::Material`].
@@ -240,7 +276,7 @@ mod tests {
             .create("transversely_isotropic", &p)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("g_axial"), "{e}");
+        assert!(e.contains("shear_modulus_axial_pa"), "{e}");
         let p = pad_params().with_num("poisson_ratio", 0.2);
         let e = r
             .materials

@@ -520,6 +520,9 @@ pub struct CaseList {
     pub skipped: Skipped,
     /// Layouts without pairs per patch size (meso; same order as `patch_m`).
     pub no_pairs_by_patch: Vec<usize>,
+    /// Layouts that repeat an earlier layout of their patch size (meso; a small region
+    /// holds few distinct layouts).
+    pub repeats_by_patch: Vec<usize>,
 }
 
 /// The seed of layout `layout` of the patch side `patch_um` (um): splitmix64 of the three.
@@ -637,6 +640,7 @@ impl StudyDef {
         let mut cases = Vec::new();
         let mut skipped = Skipped::default();
         let mut no_pairs_by_patch = Vec::new();
+        let mut repeats_by_patch = Vec::new();
         match &self.study {
             StudySpec::Macro(s) => {
                 check_mu(&s.mu)?;
@@ -776,6 +780,8 @@ impl StudyDef {
                 }
                 for &patch in &s.patch_m {
                     let mut empty = 0;
+                    let mut repeats = 0;
+                    let mut seen = std::collections::HashSet::new();
                     for l in 0..s.layouts {
                         let zone = Zone::Plateaus {
                             patch_m: patch,
@@ -789,12 +795,13 @@ impl StudyDef {
                             empty += 1;
                             continue;
                         }
-                        let area_m2 = zone
-                            .plateau_rectangles(face)
-                            .unwrap_or_default()
-                            .iter()
-                            .map(|r| r[2] * r[3])
-                            .sum();
+                        let rects = zone.plateau_rectangles(face).unwrap_or_default();
+                        let key: Vec<[i64; 2]> =
+                            rects.iter().map(|r| [um(r[0]), um(r[1])]).collect();
+                        if !seen.insert(key) {
+                            repeats += 1;
+                        }
+                        let area_m2 = rects.iter().map(|r| r[2] * r[3]).sum();
                         for &mu in &s.mu {
                             cases.push(Case {
                                 id: format!(
@@ -814,6 +821,7 @@ impl StudyDef {
                     }
                     skipped.no_pairs += empty * s.mu.len();
                     no_pairs_by_patch.push(empty);
+                    repeats_by_patch.push(repeats);
                 }
                 if cases.is_empty() {
                     return Err(input(
@@ -847,6 +855,7 @@ impl StudyDef {
             cases,
             skipped,
             no_pairs_by_patch,
+            repeats_by_patch,
         })
     }
 
@@ -859,6 +868,17 @@ impl StudyDef {
                     if n > 0 {
                         w.push(format!(
                             "patch {:.3} mm: {n} of {} layouts hold no contact pair and were skipped",
+                            p * 1e3,
+                            s.layouts
+                        ));
+                    }
+                }
+                if let Some(&n) = list.repeats_by_patch.get(i) {
+                    if n > 0 {
+                        w.push(format!(
+                            "patch {:.3} mm: {n} of {} layouts repeat an earlier one (the region \
+                             holds few distinct layouts of this patch size; the fraction counts \
+                             each repeat)",
                             p * 1e3,
                             s.layouts
                         ));

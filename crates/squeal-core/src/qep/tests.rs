@@ -532,7 +532,10 @@ fn band_driver_finds_every_mode_of_a_chain() {
 
     let modes = solve_qep_band("dense-op", &DenseOpKernel, &qep, &params).unwrap();
     assert_same_modes(&reference, &modes);
-    assert_eq!(modes.info.factorizations, 1);
+    // one for the window, plus one per mode when the left eigenvectors (cond,
+    // error_bound) come from inverse iteration rather than the transposed dense solve
+    let f = modes.info.factorizations;
+    assert!(f == 1 || f == 1 + modes.len(), "{f}");
     assert!(
         modes.info.requested > 4,
         "nev must have grown: {:?}",
@@ -650,9 +653,21 @@ fn operator_modes_are_checked_on_the_parts_like_the_assembled_operator() {
         let (lam, u) = dense_qep(&full).unwrap();
         let lam: Vec<c64> = lam.iter().map(|l| *l * c(1.0, 1e-4)).collect();
         let assembled = finish_modes(&full, &lam, u.as_ref(), &params, info("t")).unwrap();
-        let parts = finish_operator_modes(&op, mu, &lam, u.as_ref(), &params, info("t")).unwrap();
+        let mut parts =
+            finish_operator_modes(&op, mu, &lam, u.as_ref(), &params, info("t")).unwrap();
         assert!(!assembled.is_empty());
         assert_eq!(assembled.lambda, parts.lambda);
+        // condition numbers added afterwards equal those of the solve that computed them
+        assert!(parts.cond.iter().all(|c| c.is_nan()) && parts.left_vectors.is_none());
+        add_condition(&op, mu, &mut parts).unwrap();
+        assert!(parts.left_vectors.is_some());
+        for j in 0..parts.len() {
+            let (x, y) = (assembled.error_bound[j], parts.error_bound[j]);
+            assert!(x.is_finite() && x > 0.0, "mu {mu}: bound {x}");
+            assert!((x - y).abs() <= 1e-8 * x, "mu {mu}: bound {x} vs added {y}");
+            let (x, y) = (assembled.cond[j], parts.cond[j]);
+            assert!((x - y).abs() <= 1e-8 * x, "mu {mu}: cond {x} vs added {y}");
+        }
         for (x, y) in assembled.backward_error.iter().zip(&parts.backward_error) {
             assert!(*x > 1e-8, "the perturbation should show: {x:e}");
             assert!(

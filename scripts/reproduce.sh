@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Regenerates one result of the README: `bash scripts/reproduce.sh NAME`, from the
+# repository root, after `bash scripts/setup.sh`. Each writes into out/NAME (a run that is
+# interrupted continues with the same command: the long ones resume). Times are for the
+# 2-core machine the README's figures were measured on.
+#
+#   validate        the main job: Table 2, the rig, equilibria, Figure 5, bases vs full order
+#   calibrate-rig   the pin assembly fitted to the paper's datum, pin modes and couplings (~2 h)
+#   calibrate-disc  the disc fitted to Table 2
+#   macro           macroscopic zones at mu 0.36 and 0.43: centred a-sweep (b = 14.2 mm) and
+#                   off-centre zones
+#   meso-c2         mesoscopic plateaus in the coupling-2 region (0.2 mm grid)
+#   meso-c1         mesoscopic plateaus in the coupling-1 region (0.5 mm grid)
+#   bench           every basis x eigen solver at mu 0.3 and 0.7 against full order
+#   stress          the stress set (cases built to break methods)
+#
+# Extra arguments are passed to the command (e.g. `--jobs 1`, `--shard 1/2`).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+name=${1:-}
+shift || true
+cargo build --release -p squeal-cli
+squeal=target/release/squeal
+resume=()
+case "$name" in
+  validate)
+    [ -d out/validate ] && resume=(--resume)
+    $squeal validate --out out/validate "${resume[@]}" "$@" ;;
+  calibrate-rig)
+    $squeal calibrate examples/calibrate/rig.toml --out out/calibrate-rig "$@" ;;
+  calibrate-disc)
+    $squeal calibrate examples/calibrate/disc.toml --out out/calibrate-disc "$@" ;;
+  macro)
+    [ -d out/macro-centred ] && resume=(--resume)
+    $squeal sweep macro pin-on-disc --x0 centred --y0 centred --a 0.004:0.02:0.002 \
+      --b 0.0142 --mu 0.36,0.43 --basis cms --jobs 2 --out out/macro-centred "${resume[@]}" "$@"
+    resume=()
+    [ -d out/macro-grid ] && resume=(--resume)
+    $squeal sweep macro pin-on-disc --x0 0:0.016:0.004 --y0 centred --a 0.004:0.02:0.004 \
+      --b 0.004:0.02:0.004 --mu 0.36,0.43 --basis cms --jobs 2 --out out/macro-grid \
+      "${resume[@]}" "$@" ;;
+  meso-c2)
+    [ -d out/meso-c2 ] && resume=(--resume)
+    $squeal sweep meso scenes/pin-on-disc-meso.toml --coupling 2 --basis cms --jobs 2 \
+      --out out/meso-c2 "${resume[@]}" "$@" ;;
+  meso-c1)
+    [ -d out/meso-c1 ] && resume=(--resume)
+    $squeal sweep meso scenes/pin-on-disc-meso-c1.toml --coupling 1 --basis cms --jobs 2 \
+      --out out/meso-c1 "${resume[@]}" "$@" ;;
+  bench)
+    $squeal bench pin-on-disc --mu 0.3,0.7 --out out/bench "$@" ;;
+  stress)
+    $squeal bench pin-on-disc --stress --vary none --out out/stress "$@" ;;
+  *)
+    sed -n '2,18p' "$0"
+    exit 2 ;;
+esac
