@@ -1,4 +1,4 @@
-//! Reduction bases (issue 6 acceptance), at the root of the workspace:
+//! Reduction bases, at the root of the workspace:
 //!
 //! - a mu sweep through `enriched` builds its basis once per contact set (counted by a
 //!   wrapper registered at run time), a sweep through `residue` once per mu;
@@ -482,10 +482,8 @@ fn modes_cut_at_the_band_top_is_flagged_by_its_backward_error() {
     );
 }
 
-/// Mu and band of the doublet probe. On the coarse rig as built before the plate fix of
-/// session 6 (the thick plate snapped to grid lines, shorter than specified), at mu = 0.9
-/// the disc doublet at 3422.2 / 3422.9 Hz was coupled by friction into a flutter pair
-/// (DvR +-3e-5) and a basis missing one member raised the backward error 10x or more.
+/// Mu and band of the doublet probe: a basis missing one member of a disc doublet near
+/// 3.4 kHz, at a high mu where friction couples the pair.
 const DOUBLET_MU: f64 = 0.9;
 const DOUBLET_FMAX: f64 = 4000.0;
 

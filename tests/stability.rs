@@ -1,4 +1,4 @@
-//! Full-order complex eigen solvers on the frictional operator (issue 5 acceptance):
+//! Full-order complex eigen solvers on the frictional operator:
 //!
 //! - every registered backend gives the two-DOF Hoffmann model (read as a custom operator
 //!   from files) its closed-form eigenvalues, falling back to `dense` and saying so;

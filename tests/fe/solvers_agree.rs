@@ -1,6 +1,6 @@
 //! `arpack` and `krylov` on the default scene's disc: same modes, tight residuals,
 //! every mode with nodal diameters has its doublet partner, and the labelled modes meet
-//! issue 2's Table 2 acceptance (all 16 labels, at least 14 within 5 %, all within 10 %,
+//! the Table 2 acceptance (all 16 labels, at least 14 within 5 %, all within 10 %,
 //! the squeal partners a,0,3 and a,0,4 within 3 %).
 
 use crate::common::solver;

@@ -29,7 +29,7 @@ pub trait MemoryProbe: Sync {
 }
 
 /// When a run counts as accurate: every reference mode in the band found, no missed or
-/// false unstable mode, and the errors below these bounds (issue 6's acceptance).
+/// false unstable mode, and the errors below these bounds.
 #[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 pub struct Accuracy {
     /// Largest relative frequency error.

@@ -322,11 +322,14 @@ fn finish_outputs(dir: &StudyDir, def: &StudyDef, no_charts: bool) -> Result<()>
 
 fn print_summary(s: &Summary) {
     println!(
-        "{} of {} cases done, {} unstable ({:.1} %), {} failed, max backward error {:.1e}",
+        "{} of {} cases done, {} unstable ({:.1} %, 95 % interval {:.1}-{:.1} %), {} failed, \
+         max backward error {:.1e}",
         s.cases_done,
         s.cases,
         s.unstable_cases,
         100.0 * s.unstable_fraction,
+        100.0 * s.unstable_ci95[0],
+        100.0 * s.unstable_ci95[1],
         s.failed,
         s.max_backward_error
     );
@@ -354,21 +357,31 @@ fn print_summary(s: &Summary) {
     }
     if !s.by_patch.is_empty() {
         println!(
-            "  {:>6} {:>9} {:>7} {:>10}  per class",
-            "mu", "patch mm", "done", "unstable"
+            "  {:>6} {:>9} {:>7} {:>10} {:>13}  per class",
+            "mu", "patch mm", "done", "unstable", "95 % interval"
         );
         for p in &s.by_patch {
             let classes: Vec<String> = p
                 .classes
                 .iter()
-                .map(|c| format!("{:.0} Hz {:.1} %", c.class_hz, 100.0 * c.unstable_fraction))
+                .map(|c| {
+                    format!(
+                        "{:.0} Hz {:.1} % ({:.1}-{:.1})",
+                        c.class_hz,
+                        100.0 * c.unstable_fraction,
+                        100.0 * c.unstable_ci95[0],
+                        100.0 * c.unstable_ci95[1]
+                    )
+                })
                 .collect();
             println!(
-                "  {:>6.3} {:>9.3} {:>7} {:>9.1}%  {}",
+                "  {:>6.3} {:>9.3} {:>7} {:>9.1}% {:>6.1}-{:<5.1}%  {}",
                 p.mu,
                 p.patch_m * 1e3,
                 p.done,
                 100.0 * p.unstable_fraction,
+                100.0 * p.unstable_ci95[0],
+                100.0 * p.unstable_ci95[1],
                 classes.join(", ")
             );
         }

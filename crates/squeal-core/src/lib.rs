@@ -11,7 +11,9 @@
 //! - shared numerical machinery that every backend uses the same way ([`linalg`], [`qep`],
 //!   [`lowrank`] for the Woodbury path of undamped frictional operators, and [`reduction`]
 //!   for the reduction bases, [`synthesis`] for the free-interface modal synthesis shared by
-//!   every contact set of a study).
+//!   every contact set of a study);
+//! - [`interop`]: sparse matrices and whole operators to and from `nalgebra-sparse` and
+//!   `sprs` (features of the same names).
 //!
 //! Units: SI throughout (m, kg, s, N, Pa); frequencies in Hz, eigenvalues of the
 //! symmetric problem `K x = omega^2 M x` in (rad/s)^2.
@@ -20,6 +22,7 @@
 pub mod contact;
 pub mod eigen;
 pub mod error;
+pub mod interop;
 pub mod linalg;
 pub mod lowrank;
 pub mod material;

@@ -40,7 +40,7 @@ pub use run::{
     merge, run, run_case, Progress, Record, RunOptions, RunReport, StudyDir, Timing, UnstableMode,
 };
 pub use summary::{
-    summarize, ClassSummary, GridSummary, MuSummary, PatchSummary, Summary, TimingSummary,
+    summarize, wilson95, ClassSummary, GridSummary, MuSummary, PatchSummary, Summary, TimingSummary,
 };
 
 /// Errors of studies; each names the option, file or case concerned.

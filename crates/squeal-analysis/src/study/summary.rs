@@ -13,6 +13,9 @@ pub struct ClassSummary {
     pub cases: usize,
     /// `cases` over the cases done of the group (friction coefficient, patch size).
     pub unstable_fraction: f64,
+    /// Its 95 % confidence interval (Wilson score), the layouts being a random sample.
+    #[serde(default)]
+    pub unstable_ci95: [f64; 2],
     /// Smallest, mean and largest zone area of those cases (m^2).
     pub area_m2: [f64; 3],
     /// Frequency range of the class's unstable modes (Hz).
@@ -58,6 +61,9 @@ pub struct PatchSummary {
     pub unstable: usize,
     /// `unstable / done`.
     pub unstable_fraction: f64,
+    /// Its 95 % confidence interval (Wilson score).
+    #[serde(default)]
+    pub unstable_ci95: [f64; 2],
     /// Smallest and largest pairs in contact over the layouts.
     pub pairs: [usize; 2],
     /// Unstable layouts per class.
@@ -99,6 +105,9 @@ pub struct Summary {
     pub unstable_cases: usize,
     /// Overall unstable fraction of the cases done.
     pub unstable_fraction: f64,
+    /// Its 95 % confidence interval (Wilson score; meaningful for random layouts).
+    #[serde(default)]
+    pub unstable_ci95: [f64; 2],
     /// Largest backward error over every mode.
     pub max_backward_error: f64,
     /// Per friction coefficient.
@@ -121,6 +130,32 @@ pub struct GridSummary {
     pub spacing_m: [f64; 2],
     /// Pin face size (m).
     pub face_m: [f64; 2],
+}
+
+/// The 95 % Wilson score interval of a proportion `k / n` (`[0, 1]` when `n = 0`): unlike
+/// the normal approximation it stays inside `[0, 1]` and is not empty at `k = 0` or `n`.
+pub fn wilson95(k: usize, n: usize) -> [f64; 2] {
+    if n == 0 {
+        return [0.0, 1.0];
+    }
+    let z = 1.959_963_984_540_054_f64;
+    let (k, n) = (k as f64, n as f64);
+    let p = k / n;
+    let den = 1.0 + z * z / n;
+    let centre = (p + z * z / (2.0 * n)) / den;
+    let half = z / den * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt();
+    // exact ends at k = 0 and k = n (the formula gives them up to round-off)
+    let lo = if k == 0.0 {
+        0.0
+    } else {
+        (centre - half).max(0.0)
+    };
+    let hi = if k == n {
+        1.0
+    } else {
+        (centre + half).min(1.0)
+    };
+    [lo, hi]
 }
 
 fn class_summaries(solve: &SolveSpec, records: &[&Record], with_zones: bool) -> Vec<ClassSummary> {
@@ -158,6 +193,7 @@ fn class_summaries(solve: &SolveSpec, records: &[&Record], with_zones: bool) -> 
                 } else {
                     of.len() as f64 / records.len() as f64
                 },
+                unstable_ci95: wilson95(of.len(), records.len()),
                 area_m2: [ar[0], mean, ar[1]],
                 freq_hz: fix(range(&mut modes.iter().map(|m| m.freq_hz))),
                 dvr: fix(range(&mut modes.iter().map(|m| m.dvr))),
@@ -224,6 +260,7 @@ pub fn summarize(def: &StudyDef, list: &CaseList, records: &[Record]) -> Summary
                     } else {
                         u as f64 / rs.len() as f64
                     },
+                    unstable_ci95: wilson95(u, rs.len()),
                     pairs: [
                         rs.iter().map(|r| r.case.pairs).min().unwrap_or(0),
                         rs.iter().map(|r| r.case.pairs).max().unwrap_or(0),
@@ -260,6 +297,7 @@ pub fn summarize(def: &StudyDef, list: &CaseList, records: &[Record]) -> Summary
         } else {
             n_unstable as f64 / records.len() as f64
         },
+        unstable_ci95: wilson95(n_unstable, records.len()),
         max_backward_error: records
             .iter()
             .map(|r| r.max_backward_error)

@@ -402,6 +402,8 @@ fn summaries_count_classes_per_group() {
     assert_eq!(s.by_mu.len(), 2);
     assert_eq!(s.by_mu[0].classes[0].cases, 1);
     assert_eq!(s.by_mu[0].classes[0].unstable_fraction, 0.5);
+    assert_eq!(s.by_mu[0].classes[0].unstable_ci95, wilson95(1, 2));
+    assert_eq!(s.unstable_ci95, wilson95(2, 4));
     assert_eq!(s.by_mu[0].classes[1].cases, 0);
     assert_eq!(s.by_mu[1].classes[1].cases, 1);
     assert_eq!(s.by_mu[1].unclassified, 1);
@@ -410,6 +412,27 @@ fn summaries_count_classes_per_group() {
     let s = summarize(&d, &list, &records[..3]);
     assert!(!s.complete);
     assert_eq!(s.cases_done, 3);
+}
+
+#[test]
+fn wilson_intervals_match_published_values_and_stay_in_the_unit_interval() {
+    // Newcombe (1998), Table I: 81/263 -> 0.2553-0.3662; 15/148 -> 0.0624-0.1605
+    let [lo, hi] = wilson95(81, 263);
+    assert!(
+        (lo - 0.2553).abs() < 5e-5 && (hi - 0.3662).abs() < 5e-5,
+        "{lo} {hi}"
+    );
+    let [lo, hi] = wilson95(15, 148);
+    assert!(
+        (lo - 0.0624).abs() < 5e-5 && (hi - 0.1605).abs() < 5e-5,
+        "{lo} {hi}"
+    );
+    // the ends: not empty, inside [0, 1]; 0/10 -> 0-0.2775
+    let [lo, hi] = wilson95(0, 10);
+    assert!(lo == 0.0 && (hi - 0.2775).abs() < 5e-5, "{lo} {hi}");
+    let [lo, hi] = wilson95(10, 10);
+    assert!(hi == 1.0 && (lo - 0.7225).abs() < 5e-5, "{lo} {hi}");
+    assert_eq!(wilson95(0, 0), [0.0, 1.0]);
 }
 
 /// A 20 mm face with 1 mm lines and 0.2 mm lines over x in [10, 20] mm, y in [4, 18] mm
