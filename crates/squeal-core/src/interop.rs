@@ -45,7 +45,7 @@ impl<S> OperatorParts<S> {
 }
 
 impl FrictionalOperator {
-    /// The operator's parts, each converted by `f` (e.g. [`to_nalgebra`], [`to_sprs`]).
+    /// The operator's parts, each converted by `f` (e.g. `interop::to_nalgebra`, `interop::to_sprs`).
     pub fn parts_as<S>(&self, f: impl Fn(&SparseMat) -> S) -> OperatorParts<S> {
         OperatorParts {
             mc: f(&self.mc),
@@ -58,7 +58,7 @@ impl FrictionalOperator {
     }
 
     /// An operator given directly by its parts in another sparse type, each converted by
-    /// `f` (e.g. [`from_nalgebra`], [`from_sprs`]); no index map and no friction load
+    /// `f` (e.g. `interop::from_nalgebra`, `interop::from_sprs`); no index map and no friction load
     /// directions (as an operator read from files). The parts must be square, of one
     /// size, with a damping friction part only beside a damping.
     pub fn from_parts_with<S>(

@@ -5,7 +5,7 @@
 //! contact set picked by their make-up on the free-interface modes (the pin's pitch with
 //! the face bonded to the disc, the partner of both of the paper's couplings).
 //!
-//! The spec format is in `docs/calibrate.md`; [`spec`] reads and checks it, [`evaluate`]
+//! The spec format is in `docs/calibrate.md`; [`spec`] reads and checks it, [`evaluate`](mod@evaluate)
 //! measures one scene, [`fit`] runs the search.
 
 pub mod evaluate;
