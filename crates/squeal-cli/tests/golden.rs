@@ -51,7 +51,7 @@ fn check(name: &str, got: Value) {
     }
     let want = read(&path);
     let mut diffs = Vec::new();
-    compare(name, "", &want, &got, false, &mut diffs);
+    compare("", &want, &got, false, &mut diffs);
     assert!(
         diffs.is_empty(),
         "{name}: {} difference(s) from {}, first: {}",
@@ -61,7 +61,7 @@ fn check(name: &str, got: Value) {
     );
 }
 
-fn compare(name: &str, at: &str, want: &Value, got: &Value, rel: bool, diffs: &mut Vec<String>) {
+fn compare(at: &str, want: &Value, got: &Value, rel: bool, diffs: &mut Vec<String>) {
     match (want, got) {
         (Value::Object(a), Value::Object(b)) => {
             if a.keys().ne(b.keys()) {
@@ -70,7 +70,6 @@ fn compare(name: &str, at: &str, want: &Value, got: &Value, rel: bool, diffs: &m
             }
             for (k, v) in a {
                 compare(
-                    name,
                     &format!("{at}.{k}"),
                     v,
                     &b[k],
@@ -85,7 +84,7 @@ fn compare(name: &str, at: &str, want: &Value, got: &Value, rel: bool, diffs: &m
                 return;
             }
             for (i, (x, y)) in a.iter().zip(b).enumerate() {
-                compare(name, &format!("{at}[{i}]"), x, y, rel, diffs);
+                compare(&format!("{at}[{i}]"), x, y, rel, diffs);
             }
         }
         (Value::Number(a), Value::Number(b)) => {
