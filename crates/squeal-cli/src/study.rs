@@ -22,8 +22,7 @@ pub const PAPER_PATCHES_COUPLING_2: &str = "0.0004,0.0006,0.0008,0.0010,0.0012,0
 pub const PAPER_PATCHES_COUPLING_1: &str = "0.0005,0.0010,0.0015,0.0020,0.0025,0.0030,0.0035";
 /// Region cut into patches for coupling 2 (m from the face corner): the paper gives no
 /// numbers, only "medium rectangular zones near the leading edge" (section 3.1): a
-/// 10 x 14 mm rectangle on the leading (+x) half, centred radially; on the default scene
-/// it is unstable at 2169 Hz (DvR 0.0074, mu = 0.36, `enriched`).
+/// 10 x 14 mm rectangle on the leading (+x) half, centred radially.
 pub const REGION_COUPLING_2: &str = "0.010,0.003,0.010,0.014";
 /// Region for coupling 1: "large, near-square zones around the centre": 14 x 14 mm, centred.
 pub const REGION_COUPLING_1: &str = "0.003,0.003,0.014,0.014";
