@@ -35,7 +35,8 @@
 //!   when the basis does not contain the full left eigenvector the estimate can be off
 //!   (the missing part of `y` is where the true first-order error lives).
 
-use super::{check_qep, dense_qep, Qep, QepShiftInvert, QepSymbolic, QepTerms};
+use super::residual::QepTerms;
+use super::{check_qep, dense_qep, Qep, QepShiftInvert, QepSymbolic};
 use crate::{c64, Error, Result, SparseRef};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef};
@@ -81,7 +82,7 @@ impl Condition {
     }
 }
 
-/// Where the left eigenvectors of [`super::finish_terms`] come from.
+/// Where the left eigenvectors of [`super::modes::finish_terms`] come from.
 pub(super) enum LeftSource<'a> {
     /// Not computed.
     None,
@@ -445,7 +446,7 @@ fn biorthogonalize_clusters(
 /// `y^H Q' x = 0` (exact coalescence) gives infinity.
 pub(super) fn condition_numbers(
     q: &QepTerms<'_>,
-    norms: &super::QepNorms,
+    norms: &super::residual::QepNorms,
     lambda: &[c64],
     right: MatRef<'_, c64>,
     left: MatRef<'_, c64>,

@@ -1,5 +1,11 @@
+use super::residual::{backward_errors, QepNorms, QepTerms};
 use super::*;
-use crate::eigen::EigenParams;
+use crate::contact::FrictionalOperator;
+use crate::eigen::{EigenParams, SolveInfo, StopReason};
+use crate::{c64, Error};
+use faer::linalg::solvers::Solve;
+use faer::sparse::Triplet;
+use faer::Mat;
 
 const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
 

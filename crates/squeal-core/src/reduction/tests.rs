@@ -1,7 +1,14 @@
+use super::project::dense_to_sparse;
 use super::*;
-use crate::eigen::{dense_symmetric, finish_real_modes, SolveInfo};
+use crate::contact::{Basis, BasisRequest, FrictionalOperator};
+use crate::eigen::{
+    dense_symmetric, finish_real_modes, EigenParams, EigenSolver, RealModes, SolveInfo,
+    SymmetricProblem,
+};
+use crate::linalg::{dot, spmv};
 use crate::qep::finish_modes;
-use crate::qep::{backward_error, dense_qep, Qep};
+use crate::qep::{backward_error, dense_qep, ComplexModes, Qep};
+use crate::{c64, Result, SparseMat};
 
 /// Deterministic pseudo-random numbers in [-0.5, 0.5).
 struct Rng(u64);

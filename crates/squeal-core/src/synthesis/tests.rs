@@ -2,8 +2,8 @@
 //! constrained spectrum is known densely.
 
 use super::*;
-use crate::eigen::SolveInfo;
-use crate::SparseMat;
+use crate::eigen::{RealModes, SolveInfo};
+use crate::{c64, SparseMat};
 use faer::sparse::Triplet;
 use faer::Side;
 

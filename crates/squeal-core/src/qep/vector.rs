@@ -1,0 +1,31 @@
+//! Products of real sparse matrices with complex vectors, and the complex 2-norm.
+
+use crate::{c64, SparseRef};
+
+/// `y = A x` for a real sparse matrix and a complex vector (overwrites `y`).
+pub fn spmv_complex(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
+    y.iter_mut().for_each(|v| *v = c64::new(0.0, 0.0));
+    spmv_complex_add(a, x, y);
+}
+
+/// `y += A x` for a real sparse matrix and a complex vector.
+pub(super) fn spmv_complex_add(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
+    debug_assert_eq!(x.len(), a.ncols());
+    debug_assert_eq!(y.len(), a.nrows());
+    for j in 0..a.ncols() {
+        let xj = x[j];
+        if xj.re == 0.0 && xj.im == 0.0 {
+            continue;
+        }
+        for (i, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
+            y[i] += xj * *v;
+        }
+    }
+}
+
+pub(super) fn norm2_c(x: &[c64]) -> f64 {
+    x.iter()
+        .map(|v| v.re * v.re + v.im * v.im)
+        .sum::<f64>()
+        .sqrt()
+}

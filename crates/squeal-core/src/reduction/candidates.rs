@@ -1,0 +1,68 @@
+//! The vectors bases start from: the coupled mu = 0 real modes ([`coupled_real_modes`])
+//! and the friction load directions ([`friction_load_directions`]).
+
+use super::sparse_times;
+use crate::contact::{BasisRequest, FrictionalOperator};
+use crate::eigen::{EigenParams, RealModes, SymmetricProblem};
+use crate::{Error, Result};
+use faer::Mat;
+
+/// The coupled mu = 0 real modes of `(K_c, M_c)` from 0 to `cutoff_hz`, by
+/// `request.modal` (tolerances from `request.params`).
+pub fn coupled_real_modes(request: &BasisRequest<'_>, cutoff_hz: f64) -> Result<RealModes> {
+    if !(cutoff_hz.is_finite() && cutoff_hz > 0.0) {
+        return Err(Error::param(
+            "cutoff",
+            format!("cutoff frequency must be positive (Hz), got {cutoff_hz}"),
+        ));
+    }
+    let params = EigenParams {
+        fmin_hz: 0.0,
+        fmax_hz: cutoff_hz,
+        nev_hint: None,
+        ..request.params.clone()
+    };
+    let op = request.op;
+    request.modal.solve_symmetric(
+        &SymmetricProblem {
+            k: op.kc.as_ref(),
+            m: op.mc.as_ref(),
+        },
+        &params,
+    )
+}
+
+/// The friction load directions `U = T^T P~t^T` as dense columns (`n_c x nA`). When the
+/// operator does not carry them, their span is recovered from `F_K = U V_K^T`
+/// (`range F_K = range U` when `V_K` has full column rank): `F_K Omega` for a fixed
+/// pseudo-random `Omega` with as many columns as `F_K` has nonzero rows (an upper bound
+/// of its rank); the rank cut of the orthonormalization removes the surplus.
+pub fn friction_load_directions(op: &FrictionalOperator) -> Result<Mat<f64>> {
+    let n = op.dim();
+    if let Some(u) = &op.friction_loads {
+        if u.nrows() != n {
+            return Err(Error::Dimension {
+                context: "friction load directions: rows".into(),
+                expected: n,
+                got: u.nrows(),
+            });
+        }
+        return Ok(u.as_ref().to_dense());
+    }
+    let fk = op.fk.as_ref();
+    let mut used = vec![false; n];
+    for j in 0..n {
+        for i in fk.row_idx_of_col(j) {
+            used[i] = true;
+        }
+    }
+    let p = used.iter().filter(|&&u| u).count();
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let omega = Mat::from_fn(n, p, |_, _| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    });
+    Ok(sparse_times(fk, omega.as_ref()))
+}

@@ -1,0 +1,73 @@
+//! Shared machinery of the reduction bases (METHODS.md section 4), written once and used
+//! by every [`ReductionBasis`](crate::ReductionBasis):
+//!
+//! - `M_c`-orthonormalization with a rank cut ([`m_orthonormalize`],
+//!   [`m_orthonormal_extend`]) and an optional SVD compression ([`m_svd_compress`]);
+//! - the coupled mu = 0 real modes ([`coupled_real_modes`]), the friction load directions
+//!   ([`friction_load_directions`]) and static responses with one reused factorization
+//!   ([`StaticSolver`]);
+//! - projection of every part of a [`FrictionalOperator`](crate::contact::FrictionalOperator) on a basis ([`project`]), the
+//!   reduced solve with any [`EigenSolver`](crate::EigenSolver), and the expansion of the reduced modes with
+//!   their backward errors on the FULL operator ([`ReducedOperator`], [`solve_reduced`]);
+//! - the MAC between a real and a complex mode ([`mac_real_complex`]).
+//!
+//! ## Orthonormalization
+//! Columns are first scaled to unit `M_c` norm (so badly scaled static responses, e.g.
+//! `K^-1 f` of order 1e-9 m next to modes of unit modal mass, are judged on their
+//! direction only), then orthonormalized by block classical Gram-Schmidt with
+//! re-orthogonalization (every projection done twice, "twice is enough"; a column that
+//! lost more than 90 % of its norm inside its block gets a third pass against every
+//! kept column) in the `M_c` inner product: a QR factorization in that inner product. A
+//! unit column whose component outside the span of the columns kept before it has an
+//! `M_c` norm below `rank_tol` (the sine of its angle to that span) is dropped and
+//! counted. The Gram matrix `V^T M V` is never diagonalized: its eigenvalues are the
+//! squares of the singular values, so a relative cut at `tol` on them silently drops
+//! directions of relative size `sqrt(tol)`, precisely the static vectors nearly parallel
+//! to a mode.
+//!
+//! ## Reduced solve
+//! `V^T X V` for each part `X` in {`M_c`, `C_c`, `K_c`, `F_M`, `F_C`, `F_K`} (the friction
+//! parts have `4 nA` nonzero rows, so their projection is cheap), a dense-backed
+//! [`FrictionalOperator`](crate::contact::FrictionalOperator) with `t: None`, solved by any [`EigenSolver`](crate::EigenSolver) (normally `dense`)
+//! at each mu; the modes `u_c = V q` are finished by [`finish_operator_modes`](crate::qep::finish_operator_modes) on the
+//! parts of `op.at(mu)`, so their backward errors are those of the full problem. When the
+//! reduced solver returns left eigenvectors `p`, they are expanded the same way
+//! (`y = V p`) and give each mode a condition number and a forward error estimate on the
+//! full problem ([`finish_operator_modes_with_left`](crate::qep::finish_operator_modes_with_left); see the `qep::condition` module
+//! docs for the limits of this Galerkin left vector).
+
+pub use crate::linalg::sparse_times;
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatRef, Par};
+
+mod candidates;
+mod mac;
+mod orthonormal;
+mod project;
+mod solve;
+mod statics;
+#[cfg(test)]
+mod tests;
+
+pub use candidates::{coupled_real_modes, friction_load_directions};
+pub use mac::mac_real_complex;
+pub use orthonormal::{
+    m_orthonormal_extend, m_orthonormality_error, m_orthonormalize, m_svd_compress,
+    DEFAULT_RANK_TOL,
+};
+pub use project::{expand, project};
+pub use solve::{solve_reduced, ReducedOperator, ReducedSolve};
+pub use statics::{energy_residuals, StaticSolver};
+
+fn par() -> Par {
+    faer::get_global_parallelism()
+}
+
+/// `A^T B` for dense matrices.
+fn tmul(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
+    let mut c = Mat::<f64>::zeros(a.ncols(), b.ncols());
+    if a.nrows() > 0 {
+        matmul(c.as_mut(), Accum::Replace, a.transpose(), b, 1.0, par());
+    }
+    c
+}

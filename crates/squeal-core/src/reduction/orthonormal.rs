@@ -1,0 +1,219 @@
+//! `M_c`-orthonormalization with a rank cut ([`m_orthonormalize`],
+//! [`m_orthonormal_extend`], described in the module docs of [`crate::reduction`]) and
+//! SVD compression ([`m_svd_compress`]).
+
+use super::{par, sparse_times, tmul};
+use crate::linalg::{dot, spmv};
+use crate::{Error, Result, SparseRef};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatRef};
+
+/// Default relative rank cut of the orthonormalization: a unit-`M_c`-norm column is dropped
+/// when the `M_c` norm of its part outside the span of the previous columns (the sine of
+/// its angle to that span) is below this.
+pub const DEFAULT_RANK_TOL: f64 = 1e-10;
+
+/// Columns orthonormalized together (BLAS-3 projections against the kept columns).
+const BLOCK: usize = 32;
+
+/// `Y -= A B` for dense matrices.
+fn sub_mul(y: faer::MatMut<'_, f64>, a: MatRef<'_, f64>, b: MatRef<'_, f64>) {
+    if a.ncols() > 0 {
+        matmul(y, Accum::Add, a, b, -1.0, par());
+    }
+}
+
+fn check_rank_tol(rank_tol: f64) -> Result<()> {
+    if !(rank_tol > 0.0 && rank_tol < 1.0) {
+        return Err(Error::param(
+            "rank_tol",
+            format!("relative rank cut must be in (0, 1), got {rank_tol}"),
+        ));
+    }
+    Ok(())
+}
+
+/// `M`-orthonormal basis of the span of the columns of `v`, in their order, with the
+/// rank cut described in the module docs. Returns the basis and the number of columns
+/// dropped (zero, non-finite or dependent columns).
+pub fn m_orthonormalize(
+    m: SparseRef<'_>,
+    v: MatRef<'_, f64>,
+    rank_tol: f64,
+) -> Result<(Mat<f64>, usize)> {
+    let empty = Mat::<f64>::zeros(m.nrows(), 0);
+    m_orthonormal_extend(m, empty.as_ref(), v, rank_tol)
+}
+
+/// Extends the `M`-orthonormal columns `q` (kept unchanged, first) with the columns of
+/// `new`, orthonormalized against `q` and each other with the rank cut of the module
+/// docs. Returns `[q | kept new directions]` and the number of columns of `new` dropped.
+pub fn m_orthonormal_extend(
+    m: SparseRef<'_>,
+    q: MatRef<'_, f64>,
+    new: MatRef<'_, f64>,
+    rank_tol: f64,
+) -> Result<(Mat<f64>, usize)> {
+    check_rank_tol(rank_tol)?;
+    let n = m.nrows();
+    if m.ncols() != n {
+        return Err(Error::Dimension {
+            context: "M-orthonormalization: M must be square".into(),
+            expected: n,
+            got: m.ncols(),
+        });
+    }
+    for (what, rows) in [("kept columns", q.nrows()), ("new columns", new.nrows())] {
+        if rows != n {
+            return Err(Error::Dimension {
+                context: format!("M-orthonormalization: rows of the {what}"),
+                expected: n,
+                got: rows,
+            });
+        }
+    }
+    let cap = q.ncols() + new.ncols();
+    let mut out = Mat::<f64>::zeros(n, cap);
+    let mut mout = Mat::<f64>::zeros(n, cap);
+    out.as_mut().subcols_mut(0, q.ncols()).copy_from(q);
+    mout.as_mut()
+        .subcols_mut(0, q.ncols())
+        .copy_from(sparse_times(m, q).as_ref());
+    let mut k = q.ncols();
+    let mut dropped = 0;
+    let mut w = vec![0.0; n];
+    let mut mw = vec![0.0; n];
+    let mut c0 = 0;
+    while c0 < new.ncols() {
+        let b = BLOCK.min(new.ncols() - c0);
+        let mut blk = new.subcols(c0, b).to_owned();
+        let mut mblk = sparse_times(m, blk.as_ref());
+        let mut alive = vec![true; b];
+        for c in 0..b {
+            let nrm = dot(blk.col(c).try_as_col_major().unwrap().as_slice(), {
+                mblk.col(c).try_as_col_major().unwrap().as_slice()
+            });
+            if !(nrm.is_finite() && nrm > 0.0) {
+                alive[c] = false;
+                continue;
+            }
+            let s = 1.0 / nrm.sqrt();
+            blk.col_mut(c).iter_mut().for_each(|x| *x *= s);
+            mblk.col_mut(c).iter_mut().for_each(|x| *x *= s);
+        }
+        // two block passes against the kept columns
+        for _ in 0..2 {
+            if k > 0 {
+                let coef = tmul(mout.as_ref().subcols(0, k), blk.as_ref());
+                sub_mul(blk.as_mut(), out.as_ref().subcols(0, k), coef.as_ref());
+                sub_mul(mblk.as_mut(), mout.as_ref().subcols(0, k), coef.as_ref());
+            }
+        }
+        let k_block = k;
+        for c in 0..b {
+            if !alive[c] {
+                dropped += 1;
+                continue;
+            }
+            w.copy_from_slice(blk.col(c).try_as_col_major().unwrap().as_slice());
+            spmv(m, &w, &mut mw);
+            let before = dot(&w, &mw).max(0.0).sqrt();
+            if before < rank_tol || before.is_nan() {
+                dropped += 1;
+                continue;
+            }
+            let passes = |w: &mut Vec<f64>, mw: &mut Vec<f64>, from: usize, to: usize| {
+                for _ in 0..2 {
+                    if to > from {
+                        let qq = out.as_ref().subcols(from, to - from);
+                        let mq = mout.as_ref().subcols(from, to - from);
+                        let wm = faer::MatRef::from_column_major_slice(w, n, 1);
+                        let coef = tmul(mq, wm);
+                        let mut wmut = faer::MatMut::from_column_major_slice_mut(w, n, 1);
+                        sub_mul(wmut.as_mut(), qq, coef.as_ref());
+                    }
+                }
+                spmv(m, w, mw);
+                dot(w, mw).max(0.0).sqrt()
+            };
+            let mut nrm = passes(&mut w, &mut mw, k_block, k);
+            if nrm < 0.1 * before {
+                // heavy cancellation inside the block: one more pass against everything
+                nrm = passes(&mut w, &mut mw, 0, k);
+            }
+            if !(nrm >= rank_tol && nrm.is_finite()) {
+                dropped += 1;
+                continue;
+            }
+            for r in 0..n {
+                out[(r, k)] = w[r] / nrm;
+                mout[(r, k)] = mw[r] / nrm;
+            }
+            k += 1;
+        }
+        c0 += b;
+    }
+    let out = out.as_ref().subcols(0, k).to_owned();
+    Ok((out, dropped))
+}
+
+/// Compresses the span of the columns of `v` by an SVD in the `M` inner product: columns
+/// scaled to unit `M` norm, `M`-orthonormalized (`S = Q R`, rank cut
+/// [`DEFAULT_RANK_TOL`]), `R = U Sigma W^T`; keeps `Q U_r` for the singular values
+/// `sigma_i > svd_tol sigma_1`. Returns the `M`-orthonormal directions and the number of
+/// columns of `v` they replace minus the number kept (dropped).
+pub fn m_svd_compress(
+    m: SparseRef<'_>,
+    v: MatRef<'_, f64>,
+    svd_tol: f64,
+) -> Result<(Mat<f64>, usize)> {
+    if !(svd_tol > 0.0 && svd_tol < 1.0) {
+        return Err(Error::param(
+            "svd_tol",
+            format!("relative singular value cut must be in (0, 1), got {svd_tol}"),
+        ));
+    }
+    let n = m.nrows();
+    let mut s = v.to_owned();
+    let ms = sparse_times(m, v);
+    for c in 0..s.ncols() {
+        let nrm = (0..n).map(|r| s[(r, c)] * ms[(r, c)]).sum::<f64>().sqrt();
+        let f = if nrm.is_finite() && nrm > 0.0 {
+            1.0 / nrm
+        } else {
+            0.0
+        };
+        s.col_mut(c).iter_mut().for_each(|x| *x *= f);
+    }
+    let (q, _) = m_orthonormalize(m, s.as_ref(), DEFAULT_RANK_TOL)?;
+    if q.ncols() == 0 {
+        return Ok((q, v.ncols()));
+    }
+    let r = tmul(sparse_times(m, q.as_ref()).as_ref(), s.as_ref());
+    let svd = r
+        .thin_svd()
+        .map_err(|e| Error::Invalid(format!("SVD of the M-QR factor failed: {e:?}")))?;
+    let sig = svd.S();
+    let smax = (0..sig.dim()).fold(0.0f64, |a, i| a.max(sig[i]));
+    let keep: Vec<usize> = (0..sig.dim())
+        .filter(|&i| sig[i] > svd_tol * smax)
+        .collect();
+    let u = svd.U();
+    let ur = Mat::from_fn(u.nrows(), keep.len(), |i, j| u[(i, keep[j])]);
+    let out = &q * &ur;
+    let dropped = v.ncols() - keep.len();
+    Ok((out, dropped))
+}
+
+/// Largest entry of `|V^T M V - I|`: how far `V` is from `M`-orthonormal.
+pub fn m_orthonormality_error(m: SparseRef<'_>, v: MatRef<'_, f64>) -> f64 {
+    let g = tmul(v, sparse_times(m, v).as_ref());
+    let mut worst = 0.0f64;
+    for j in 0..g.ncols() {
+        for i in 0..g.nrows() {
+            let e = g[(i, j)] - if i == j { 1.0 } else { 0.0 };
+            worst = worst.max(e.abs());
+        }
+    }
+    worst
+}

@@ -1,0 +1,114 @@
+//! Projection of every part of a frictional operator on a basis (`V^T X V`,
+//! [`project`]) and expansion of reduced vectors (`u = V q`, [`expand`]).
+
+use super::{par, sparse_times, tmul};
+use crate::contact::FrictionalOperator;
+use crate::{c64, Error, Result, SparseMat, SparseRef};
+use faer::linalg::matmul::matmul;
+use faer::sparse::Triplet;
+use faer::{Accum, Mat, MatRef};
+
+/// A dense matrix stored as a sparse one (its nonzero entries).
+pub(super) fn dense_to_sparse(a: MatRef<'_, f64>) -> Result<SparseMat> {
+    let mut t = Vec::with_capacity(a.nrows() * a.ncols());
+    for j in 0..a.ncols() {
+        for i in 0..a.nrows() {
+            if a[(i, j)] != 0.0 {
+                t.push(Triplet::new(i, j, a[(i, j)]));
+            }
+        }
+    }
+    SparseMat::try_new_from_triplets(a.nrows(), a.ncols(), &t)
+        .map_err(|e| Error::Invalid(format!("reduced matrix: {e:?}")))
+}
+
+/// `V^T X V` exploiting the zero rows of `X` (the friction parts have `4 nA` nonzero
+/// rows).
+fn project_part(x: SparseRef<'_>, v: MatRef<'_, f64>) -> Result<SparseMat> {
+    let n = x.nrows();
+    let mut used = vec![false; n];
+    for j in 0..x.ncols() {
+        for i in x.row_idx_of_col(j) {
+            used[i] = true;
+        }
+    }
+    let rows: Vec<usize> = (0..n).filter(|&i| used[i]).collect();
+    let m = v.ncols();
+    if rows.is_empty() {
+        return dense_to_sparse(Mat::<f64>::zeros(m, m).as_ref());
+    }
+    let xv = sparse_times(x, v);
+    let red = if rows.len() == n {
+        tmul(v, xv.as_ref())
+    } else {
+        let vr = Mat::from_fn(rows.len(), m, |i, j| v[(rows[i], j)]);
+        let yr = Mat::from_fn(rows.len(), m, |i, j| xv[(rows[i], j)]);
+        tmul(vr.as_ref(), yr.as_ref())
+    };
+    dense_to_sparse(red.as_ref())
+}
+
+/// Projects every part of `op` on the columns of `v` (`n_c x m`): `X_r = V^T X V`, the
+/// friction load directions to `V^T U`, no index map. The result is a small
+/// (dense-backed) operator that any [`EigenSolver`](crate::EigenSolver) solves.
+pub fn project(op: &FrictionalOperator, v: MatRef<'_, f64>) -> Result<FrictionalOperator> {
+    let n = op.dim();
+    if v.nrows() != n {
+        return Err(Error::Dimension {
+            context: "projection: rows of the basis".into(),
+            expected: n,
+            got: v.nrows(),
+        });
+    }
+    if v.ncols() == 0 {
+        return Err(Error::Invalid("projection on an empty basis".into()));
+    }
+    let opt = |x: &Option<SparseMat>| -> Result<Option<SparseMat>> {
+        x.as_ref().map(|x| project_part(x.as_ref(), v)).transpose()
+    };
+    let friction_loads = match &op.friction_loads {
+        Some(u) => {
+            // V^T U column by column: U has a few nonzeros per column (never densified:
+            // `n x nA` would be gigabytes for thousands of pairs)
+            let u = u.as_ref();
+            let mut r = Mat::<f64>::zeros(v.ncols(), u.ncols());
+            for j in 0..u.ncols() {
+                for (i, x) in u.row_idx_of_col(j).zip(u.val_of_col(j)) {
+                    for c in 0..v.ncols() {
+                        r[(c, j)] += x * v[(i, c)];
+                    }
+                }
+            }
+            Some(dense_to_sparse(r.as_ref())?)
+        }
+        None => None,
+    };
+    Ok(FrictionalOperator {
+        mc: project_part(op.mc.as_ref(), v)?,
+        cc: opt(&op.cc)?,
+        kc: project_part(op.kc.as_ref(), v)?,
+        fm: project_part(op.fm.as_ref(), v)?,
+        fc: opt(&op.fc)?,
+        fk: project_part(op.fk.as_ref(), v)?,
+        t: None,
+        friction_loads,
+    })
+}
+
+/// Expands reduced vectors: `u = V q` (`V` real `n x m`, `q` complex `m x k`).
+pub fn expand(v: MatRef<'_, f64>, q: MatRef<'_, c64>) -> Mat<c64> {
+    // One real product V [Re Q, Im Q] (BLAS-3, parallel), then recombined.
+    let k = q.ncols();
+    let parts = Mat::from_fn(q.nrows(), 2 * k, |i, j| {
+        if j < k {
+            q[(i, j)].re
+        } else {
+            q[(i, j - k)].im
+        }
+    });
+    let mut u = Mat::<f64>::zeros(v.nrows(), 2 * k);
+    if k > 0 && v.ncols() > 0 {
+        matmul(u.as_mut(), Accum::Replace, v, parts.as_ref(), 1.0, par());
+    }
+    Mat::from_fn(v.nrows(), k, |i, j| c64::new(u[(i, j)], u[(i, j + k)]))
+}

@@ -1,0 +1,257 @@
+//! Construction of a [`FreeInterface`] (modes, static contact responses, residual
+//! contact flexibilities) and what it tells about itself.
+
+use super::{add_pair_load, par, FreeInterface, PairDofs, Stored, STORE_LIMIT_BYTES};
+use crate::contact::FrictionalOperator;
+use crate::eigen::RealModes;
+use crate::linalg::Cholesky;
+use crate::{Error, Result, SparseMat, SparseRef};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatRef};
+use std::time::Instant;
+
+/// `K^-1` in place on the columns of `x`, `BLOCK` at a time (bounded workspace).
+fn solve_blocks(factor: &Cholesky, x: &mut Mat<f64>) {
+    let mut c0 = 0;
+    while c0 < x.ncols() {
+        let b = BLOCK.min(x.ncols() - c0);
+        factor.solve_in_place(x.as_mut().subcols_mut(c0, b));
+        c0 += b;
+    }
+}
+
+/// Columns solved together.
+const BLOCK: usize = 64;
+
+impl FreeInterface {
+    /// Builds the free-interface data of the model `(k, m)` (free DOFs, `K` positive
+    /// definite) for the candidate `pairs`, with the free-interface `modes` (of the same
+    /// `(K, M)`, `M`-orthonormal, e.g. from an [`EigenSolver`](crate::EigenSolver) up to a
+    /// cutoff above the band). The static responses of the pairs are stored when they fit
+    /// in [`STORE_LIMIT_BYTES`], otherwise solved for each expansion.
+    pub fn new(
+        k: SparseRef<'_>,
+        m: SparseRef<'_>,
+        pairs: &[PairDofs],
+        modes: &RealModes,
+    ) -> Result<Self> {
+        Self::with_store_limit(k, m, pairs, modes, STORE_LIMIT_BYTES)
+    }
+
+    /// [`FreeInterface::new`] with the memory limit (bytes) of the stored static
+    /// responses (`32 n nR` bytes); 0 never stores them. Both ways give the same modes to
+    /// round-off.
+    pub fn with_store_limit(
+        k: SparseRef<'_>,
+        m: SparseRef<'_>,
+        pairs: &[PairDofs],
+        modes: &RealModes,
+        store_limit_bytes: usize,
+    ) -> Result<Self> {
+        let start = Instant::now();
+        let n = k.nrows();
+        let nr = pairs.len();
+        let nm = modes.omega2.len();
+        if nr == 0 {
+            return Err(Error::Invalid(
+                "free-interface synthesis: no candidate contact pair".into(),
+            ));
+        }
+        if modes.vectors.nrows() != n || modes.vectors.ncols() != nm {
+            return Err(Error::Dimension {
+                context: "free-interface synthesis: mode shapes against K".into(),
+                expected: n,
+                got: modes.vectors.nrows(),
+            });
+        }
+        if m.nrows() != n || m.ncols() != n {
+            return Err(Error::Dimension {
+                context: "free-interface synthesis: M against K".into(),
+                expected: n,
+                got: m.nrows(),
+            });
+        }
+        if nm == 0 {
+            return Err(Error::Invalid(
+                "free-interface synthesis: no free-interface mode below the cutoff".into(),
+            ));
+        }
+        if let Some(&w) = modes.omega2.iter().find(|w| !(w.is_finite() && **w > 0.0)) {
+            return Err(Error::Invalid(format!(
+                "free-interface synthesis: eigenvalue omega^2 = {w:e} (rad/s)^2 is not \
+                 positive: the unconstrained model must be held (no rigid-body mode)"
+            )));
+        }
+        for (i, p) in pairs.iter().enumerate() {
+            if p.pin.iter().chain(&p.disc).any(|&d| d >= n) {
+                return Err(Error::Invalid(format!(
+                    "free-interface synthesis: pair {i} has a DOF beyond the model's {n}"
+                )));
+            }
+        }
+        let factor = Cholesky::new(k, "K (free-interface synthesis)")?;
+        let pn_rows = |x: MatRef<'_, f64>| {
+            Mat::from_fn(nr, x.ncols(), |i, c| {
+                x[(pairs[i].pin[2], c)] - x[(pairs[i].disc[2], c)]
+            })
+        };
+        let pt_rows = |x: MatRef<'_, f64>| {
+            Mat::from_fn(nr, x.ncols(), |i, c| {
+                let p = &pairs[i];
+                (0..2)
+                    .map(|a| p.direction[a] * (x[(p.pin[a], c)] - x[(p.disc[a], c)]))
+                    .sum()
+            })
+        };
+        let phi = modes.vectors.clone();
+        let pn_phi = pn_rows(phi.as_ref());
+        let pt_phi = pt_rows(phi.as_ref());
+        // Pn K^-1 Pn^T and Pn K^-1 Pt^T, a block of pairs at a time; the whole responses
+        // kept when they fit
+        let mut wfull = Mat::<f64>::zeros(nr, nr);
+        let mut wt = Mat::<f64>::zeros(nr, nr);
+        let store = 32usize.saturating_mul(n).saturating_mul(nr) <= store_limit_bytes;
+        let mut stored = store.then(|| Stored {
+            zn: Mat::zeros(n, nr),
+            zt: Mat::zeros(n, nr),
+            yn: Mat::zeros(0, 0),
+            yt: Mat::zeros(0, 0),
+        });
+        let mut c0 = 0;
+        while c0 < nr {
+            let b = BLOCK.min(nr - c0);
+            // unit normal loads in the first b columns, unit sliding loads in the next b
+            let mut x = Mat::<f64>::zeros(n, 2 * b);
+            for (j, p) in pairs[c0..c0 + b].iter().enumerate() {
+                add_pair_load(&mut x, p, j, 1.0, 0.0);
+                add_pair_load(&mut x, p, b + j, 0.0, 1.0);
+            }
+            factor.solve_in_place(x.as_mut());
+            if let Some(st) = stored.as_mut() {
+                st.zn
+                    .as_mut()
+                    .subcols_mut(c0, b)
+                    .copy_from(x.as_ref().subcols(0, b));
+                st.zt
+                    .as_mut()
+                    .subcols_mut(c0, b)
+                    .copy_from(x.as_ref().subcols(b, b));
+            }
+            let rows = pn_rows(x.as_ref());
+            wfull
+                .as_mut()
+                .subcols_mut(c0, b)
+                .copy_from(rows.as_ref().subcols(0, b));
+            wt.as_mut()
+                .subcols_mut(c0, b)
+                .copy_from(rows.as_ref().subcols(b, b));
+            c0 += b;
+        }
+        if let Some(st) = stored.as_mut() {
+            // second-order residual terms K^-1 M K^-1 (Pn^T | Pt^T)
+            for (z, y) in [(&st.zn, &mut st.yn), (&st.zt, &mut st.yt)] {
+                *y = crate::reduction::sparse_times(m, z.as_ref());
+                solve_blocks(&factor, y);
+            }
+        }
+        let mut wn = wfull.clone();
+        // residual flexibility: subtract Pn Phi Omega^-2 (Pn Phi | Pt Phi)^T
+        let scaled = Mat::from_fn(nr, nm, |i, c| pn_phi[(i, c)] / modes.omega2[c]);
+        matmul(
+            wn.as_mut(),
+            Accum::Add,
+            scaled.as_ref(),
+            pn_phi.transpose(),
+            -1.0,
+            par(),
+        );
+        matmul(
+            wt.as_mut(),
+            Accum::Add,
+            scaled.as_ref(),
+            pt_phi.transpose(),
+            -1.0,
+            par(),
+        );
+        let cutoff_hz = modes.omega2.iter().fold(0.0f64, |a, &w| a.max(w)).sqrt()
+            / (2.0 * std::f64::consts::PI);
+        Ok(Self {
+            pairs: pairs.to_vec(),
+            phi,
+            omega2: modes.omega2.clone(),
+            factor,
+            stored,
+            m: SparseMat::new(
+                m.symbolic()
+                    .to_owned()
+                    .map_err(|e| Error::Invalid(format!("copy of M: {e:?}")))?,
+                m.val().to_vec(),
+            ),
+            wfull,
+            wn,
+            wt,
+            pn_phi,
+            pt_phi,
+            cutoff_hz,
+            time_s: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Whether the static responses of the pairs are stored (else solved per expansion).
+    pub fn stores_responses(&self) -> bool {
+        self.stored.is_some()
+    }
+
+    /// Number of candidate pairs.
+    pub fn pairs(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Number of free-interface modes.
+    pub fn modes(&self) -> usize {
+        self.omega2.len()
+    }
+
+    /// Number of unconstrained DOFs.
+    pub fn dofs(&self) -> usize {
+        self.phi.nrows()
+    }
+
+    /// The candidate pairs (region indices are positions in this list).
+    pub fn pair_dofs(&self) -> &[PairDofs] {
+        &self.pairs
+    }
+
+    /// The region indices of the pairs tied in `op` (its index map relabels their pin
+    /// normal DOF onto the disc's). An error when `op` has no index map, another size, or
+    /// active pairs outside the candidate set.
+    pub fn active_in(&self, op: &FrictionalOperator) -> Result<Vec<usize>> {
+        let t = op.t.as_ref().ok_or_else(|| {
+            Error::Invalid(
+                "free-interface synthesis: the operator has no index map T (it was read \
+                 from files); build it from a scene"
+                    .into(),
+            )
+        })?;
+        if t.len() != self.dofs() {
+            return Err(Error::Dimension {
+                context: "free-interface synthesis: operator's unconstrained DOFs".into(),
+                expected: self.dofs(),
+                got: t.len(),
+            });
+        }
+        let active: Vec<usize> = (0..self.pairs.len())
+            .filter(|&i| t[self.pairs[i].pin[2]] == t[self.pairs[i].disc[2]])
+            .collect();
+        let tied = t.len() - op.dim();
+        if tied != active.len() {
+            return Err(Error::Invalid(format!(
+                "free-interface synthesis: the operator ties {tied} pairs but only {} of \
+                 them are among the {} candidate pairs of the synthesis",
+                active.len(),
+                self.pairs.len()
+            )));
+        }
+        Ok(active)
+    }
+}

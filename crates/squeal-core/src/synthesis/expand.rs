@@ -1,0 +1,205 @@
+//! Expansion of synthesized modes to the unconstrained DOFs ([`FreeInterface::expand`])
+//! and their second-order residual correction ([`FreeInterface::correction`]).
+
+use super::{add_pair_load, par, FreeInterface, Synthesized};
+use crate::{c64, Error, Result};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatRef};
+
+impl FreeInterface {
+    /// The unconstrained displacements `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r` of the
+    /// synthesized modes `which` (`n x which.len()`).
+    pub fn expand(&self, syn: &Synthesized, which: &[usize]) -> Mat<c64> {
+        let (u, _) = self.combine(syn, which, false, None);
+        self.complex(&u, which.len())
+    }
+
+    /// [`FreeInterface::expand`] and [`FreeInterface::correction`] together: when the
+    /// static responses are solved (not stored), the correction reuses the expansion's
+    /// `K^-1 B_A^T r` (one block solve fewer).
+    pub fn expand_with_correction(
+        &self,
+        syn: &Synthesized,
+        which: &[usize],
+    ) -> Result<(Mat<c64>, Mat<c64>)> {
+        let (u, z) = self.combine(syn, which, false, None);
+        let w = self.correction_from(syn, which, z.as_ref())?;
+        Ok((self.complex(&u, which.len()), w))
+    }
+
+    /// Real and imaginary parts side by side (`n x 2k`) to complex columns (`n x k`).
+    fn complex(&self, u: &Mat<f64>, k: usize) -> Mat<c64> {
+        Mat::from_fn(self.dofs(), k, |i, c| c64::new(u[(i, c)], u[(i, k + c)]))
+    }
+
+    /// `Phi e + (Y_n + mu Y_t) r` for the modes `which`, real and imaginary parts side by
+    /// side (`n x 2 which.len()`): with `second = false`, `e = eta - Omega^-2 Q^T r` and
+    /// `Y = K^-1 (Pn^T | Pt^T)` (the expansion); with `second = true`, `e = -Omega^-4 Q^T r`
+    /// and `Y = K^-1 M K^-1 (Pn^T | Pt^T)` (the second-order residual term). When the
+    /// responses are solved, the first-order call also returns `K^-1 B^T r` and the
+    /// second-order one takes it back as `reuse`.
+    fn combine(
+        &self,
+        syn: &Synthesized,
+        which: &[usize],
+        second: bool,
+        reuse: Option<&Mat<f64>>,
+    ) -> (Mat<f64>, Option<Mat<f64>>) {
+        let nm = self.modes();
+        let k = which.len();
+        let mu = syn.mu;
+        let mut coef = Mat::<f64>::zeros(nm, 2 * k);
+        let mut rfull = Mat::<f64>::zeros(self.pairs(), 2 * k);
+        for (c, &w) in which.iter().enumerate() {
+            for (row, &i) in syn.active.iter().enumerate() {
+                let rv = syn.r[(row, w)];
+                rfull[(i, c)] = rv.re;
+                rfull[(i, k + c)] = rv.im;
+            }
+            for j in 0..nm {
+                let mut qtr = c64::new(0.0, 0.0);
+                for (row, &i) in syn.active.iter().enumerate() {
+                    qtr += syn.r[(row, w)] * (self.pn_phi[(i, j)] + mu * self.pt_phi[(i, j)]);
+                }
+                let e = if second {
+                    qtr * (-1.0 / (self.omega2[j] * self.omega2[j]))
+                } else {
+                    syn.eta[(j, w)] - qtr * (1.0 / self.omega2[j])
+                };
+                coef[(j, c)] = e.re;
+                coef[(j, k + c)] = e.im;
+            }
+        }
+        // K^-1 B^T r, or K^-1 M K^-1 B^T r
+        let mut first = None;
+        let mut u = match &self.stored {
+            Some(st) => {
+                let (yn, yt) = if second {
+                    (&st.yn, &st.yt)
+                } else {
+                    (&st.zn, &st.zt)
+                };
+                let mut u = Mat::<f64>::zeros(self.dofs(), 2 * k);
+                matmul(
+                    u.as_mut(),
+                    Accum::Replace,
+                    yn.as_ref(),
+                    rfull.as_ref(),
+                    1.0,
+                    par(),
+                );
+                if mu != 0.0 {
+                    matmul(
+                        u.as_mut(),
+                        Accum::Add,
+                        yt.as_ref(),
+                        rfull.as_ref(),
+                        mu,
+                        par(),
+                    );
+                }
+                u
+            }
+            None => {
+                let z = match reuse {
+                    Some(z) => z.clone(),
+                    None => self.static_response(rfull.as_ref(), mu),
+                };
+                if second {
+                    let mut u = crate::reduction::sparse_times(self.m.as_ref(), z.as_ref());
+                    self.factor.solve_in_place(u.as_mut());
+                    u
+                } else {
+                    first = Some(z.clone());
+                    z
+                }
+            }
+        };
+        matmul(
+            u.as_mut(),
+            Accum::Add,
+            self.phi.as_ref(),
+            coef.as_ref(),
+            1.0,
+            par(),
+        );
+        (u, first)
+    }
+
+    /// `K^-1 (Pn^T + mu Pt^T) r` for the pair loads `r` (`nR x c`, N): `n x c` (m).
+    fn static_response(&self, r: MatRef<'_, f64>, mu: f64) -> Mat<f64> {
+        let mut x = Mat::<f64>::zeros(self.dofs(), r.ncols());
+        for (i, p) in self.pairs.iter().enumerate() {
+            for c in 0..r.ncols() {
+                let v = r[(i, c)];
+                if v != 0.0 {
+                    add_pair_load(&mut x, p, c, v, mu * v);
+                }
+            }
+        }
+        if r.ncols() > 0 {
+            self.factor.solve_in_place(x.as_mut());
+        }
+        x
+    }
+
+    /// The second-order residual directions of the synthesized modes `which`:
+    /// `w = G2 B_A^T r`, `G2 = K^-1 M K^-1 - Phi Omega^-4 Phi^T` (the first term the static
+    /// residual flexibility leaves out, `R(lambda) = G - lambda^2 G2 + ...`), made to satisfy
+    /// the ties by the static correction `w - K^-1 Pn_A^T (Pn_A K^-1 Pn_A^T)^-1 Pn_A w`
+    /// (`n x which.len()`). Added to the expanded modes they let the Ritz step recover most
+    /// of the residual inertia.
+    pub fn correction(&self, syn: &Synthesized, which: &[usize]) -> Result<Mat<c64>> {
+        self.correction_from(syn, which, None)
+    }
+
+    /// [`FreeInterface::correction`], reusing the expansion's `K^-1 B_A^T r` if given.
+    fn correction_from(
+        &self,
+        syn: &Synthesized,
+        which: &[usize],
+        reuse: Option<&Mat<f64>>,
+    ) -> Result<Mat<c64>> {
+        let n = self.dofs();
+        let nr = self.pairs();
+        let na = syn.active.len();
+        let k = which.len();
+        let (mut w, _) = self.combine(syn, which, true, reuse);
+        if na > 0 {
+            // static correction onto the ties: c = W_AA^-1 Pn_A w, w -= K^-1 Pn_A^T c
+            let waa = Mat::from_fn(na, na, |i, j| self.wfull[(syn.active[i], syn.active[j])]);
+            let gaps = Mat::from_fn(na, 2 * k, |i, c| {
+                let p = &self.pairs[syn.active[i]];
+                w[(p.pin[2], c)] - w[(p.disc[2], c)]
+            });
+            let lu = waa.partial_piv_lu();
+            let cfix = faer::linalg::solvers::Solve::solve(&lu, &gaps);
+            if !(0..2 * k).all(|c| (0..na).all(|i| cfix[(i, c)].is_finite())) {
+                return Err(Error::Factorization {
+                    what: format!("static contact flexibility ({na} pairs)"),
+                    reason: "singular: a pair repeated".into(),
+                });
+            }
+            let mut cf = Mat::<f64>::zeros(nr, 2 * k);
+            for (row, &i) in syn.active.iter().enumerate() {
+                for c in 0..2 * k {
+                    cf[(i, c)] = cfix[(row, c)];
+                }
+            }
+            match &self.stored {
+                Some(st) => matmul(
+                    w.as_mut(),
+                    Accum::Add,
+                    st.zn.as_ref(),
+                    cf.as_ref(),
+                    -1.0,
+                    par(),
+                ),
+                None => w -= &self.static_response(cf.as_ref(), 0.0),
+            }
+        }
+        Ok(Mat::from_fn(n, k, |i, c| {
+            c64::new(w[(i, c)], w[(i, k + c)])
+        }))
+    }
+}

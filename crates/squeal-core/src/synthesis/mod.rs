@@ -1,0 +1,111 @@
+//! Free-interface modal synthesis with residual flexibility (MacNeal) for a family of
+//! contact sets drawn from one set of candidate pairs: the machinery behind the `cms`
+//! basis, built once per model and region and then reused for every contact set and mu.
+//!
+//! For the active pairs `A` the linearized problem is the descriptor system
+//! `(lambda^2 M + K) u = B_A^T r`, `Pn_A u = 0`, `B_A = Pn_A + mu Pt_A` (METHODS.md
+//! section 2, undamped). With the free-interface modes `Phi` of the unconstrained model
+//! (no pair tied: `K Phi = M Phi Omega^2`, `Phi^T M Phi = I`) up to a cutoff, and the
+//! residual flexibility `G = K^-1 - Phi Omega^-2 Phi^T` taken at `lambda = 0`,
+//!
+//! `u = Phi eta + G B_A^T r`, `(lambda^2 + Omega^2) eta = Phi^T B_A^T r`.
+//!
+//! The ties give `r = -S^-1 P eta` with `S = Pn_A G B_A^T` (`nA x nA`) and `P = Pn_A Phi`,
+//! hence the `m x m` standard eigenproblem `lambda^2 eta = -(Omega^2 + Q^T S^-1 P) eta`,
+//! `Q = B_A Phi`, whatever the number of pairs. The residual contact flexibilities
+//! `Pn G Pn^T`, `Pn G Pt^T` of the candidate pairs are computed once (one Cholesky
+//! factorization of `K`, kept, and `2 nR` solves whose pair rows alone are kept, so the
+//! memory is `O(nR^2)`, not `O(n nR)`; the whole responses `K^-1 (Pn^T | Pt^T)` and their
+//! second-order terms are stored too when they fit [`STORE_LIMIT_BYTES`]): a new contact
+//! set or mu then costs one `nA x nA` LU, one `m x m` eigen decomposition and the
+//! expansion `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r` (products with the stored
+//! responses, or block solves for the modes expanded), which satisfies `Pn_A u = 0`
+//! exactly.
+//!
+//! The residual flexibility is static (its inertia is neglected), so the synthesized modes
+//! are approximations whose error falls with the ratio of the band to the modal cutoff;
+//! the `cms` basis uses them as Ritz vectors of the exact operator of the contact set, so
+//! every returned mode still carries its backward error on the full operator.
+//!
+//! Normals are `+e_z` (flat disc face), as in the operator builder.
+
+use crate::linalg::Cholesky;
+use crate::SparseMat;
+use faer::{Mat, Par};
+
+mod construct;
+mod expand;
+mod synthesize;
+#[cfg(test)]
+mod tests;
+
+pub use synthesize::Synthesized;
+
+/// The DOFs of one candidate contact pair in the unconstrained (free) numbering.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairDofs {
+    /// Pin node DOFs (x, y, z).
+    pub pin: [usize; 3],
+    /// Disc node DOFs (x, y, z).
+    pub disc: [usize; 3],
+    /// Unit in-plane sliding direction `e_i` (the friction on the pin points along it).
+    pub direction: [f64; 3],
+}
+
+/// The free-interface data of one model and one set of candidate pairs (see the module
+/// docs): modes, static contact responses and residual contact flexibilities.
+pub struct FreeInterface {
+    pairs: Vec<PairDofs>,
+    phi: Mat<f64>,
+    omega2: Vec<f64>,
+    /// Cholesky factor of `K`: the static responses `K^-1 (Pn^T | Pt^T) r` of the
+    /// expansion, solved for the modes expanded (when they are not stored).
+    factor: Cholesky,
+    /// The static responses of every candidate pair, stored when they fit the memory
+    /// limit: faster expansions, `4 n nR` values.
+    stored: Option<Stored>,
+    /// `M`, for the second-order residual terms `K^-1 M K^-1 (.)`.
+    m: SparseMat,
+    /// Full static `Pn K^-1 Pn^T` (`nR x nR`, m/N).
+    wfull: Mat<f64>,
+    /// Residual `Pn G Pn^T` (`nR x nR`, m/N).
+    wn: Mat<f64>,
+    /// Residual `Pn G Pt^T` (`nR x nR`, m/N).
+    wt: Mat<f64>,
+    /// `Pn Phi`, `Pt Phi` (`nR x m`).
+    pn_phi: Mat<f64>,
+    pt_phi: Mat<f64>,
+    /// Highest free-interface frequency kept (Hz).
+    pub cutoff_hz: f64,
+    /// Wall time of the construction, modes excluded (s).
+    pub time_s: f64,
+}
+
+/// `K^-1 Pn^T`, `K^-1 Pt^T` and the second-order terms `K^-1 M K^-1 (Pn^T | Pt^T)`
+/// (`n x nR` each).
+struct Stored {
+    zn: Mat<f64>,
+    zt: Mat<f64>,
+    yn: Mat<f64>,
+    yt: Mat<f64>,
+}
+
+/// Largest memory (bytes) [`FreeInterface::new`] spends on stored static responses.
+pub const STORE_LIMIT_BYTES: usize = 3 << 30;
+
+fn par() -> Par {
+    faer::get_global_parallelism()
+}
+
+/// Adds to column `c` of `x` the pair loads `Pn^T normal + Pt^T sliding` of pair `p`
+/// (on the pin node, and opposite on the disc node).
+fn add_pair_load(x: &mut Mat<f64>, p: &PairDofs, c: usize, normal: f64, sliding: f64) {
+    x[(p.pin[2], c)] += normal;
+    x[(p.disc[2], c)] -= normal;
+    if sliding != 0.0 {
+        for a in 0..2 {
+            x[(p.pin[a], c)] += sliding * p.direction[a];
+            x[(p.disc[a], c)] -= sliding * p.direction[a];
+        }
+    }
+}
