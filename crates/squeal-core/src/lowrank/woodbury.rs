@@ -3,6 +3,7 @@
 
 use super::SymmetricShift;
 use crate::linalg::norm1;
+use crate::qep::vector::spmv_complex_split;
 use crate::qep::{ComplexLinOp, Qep};
 use crate::{c64, Error, Result};
 use faer::linalg::matmul::matmul;
@@ -218,18 +219,7 @@ impl ComplexLinOp for QepLowRankSquared<'_> {
             n,
             "QepLowRankSquared::apply: y has the wrong length"
         );
-        let mut b = Mat::<f64>::zeros(n, 2);
-        let m = self.qep.m.as_ref();
-        for j in 0..n {
-            let (xr, xi) = (x[j].re, x[j].im);
-            if xr == 0.0 && xi == 0.0 {
-                continue;
-            }
-            for (i, v) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
-                b[(i, 0)] += v * xr;
-                b[(i, 1)] += v * xi;
-            }
-        }
+        let mut b = spmv_complex_split(self.qep.m.as_ref(), x);
         self.solve_in_place(b.as_mut());
         for (i, v) in y.iter_mut().enumerate() {
             *v = c64::new(b[(i, 0)], b[(i, 1)]);

@@ -30,7 +30,7 @@ mod residual;
 mod shift_invert;
 #[cfg(test)]
 mod tests;
-mod vector;
+pub(crate) mod vector;
 mod window;
 
 pub use band::{

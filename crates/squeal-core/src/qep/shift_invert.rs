@@ -2,14 +2,14 @@
 //! ([`QepShiftInvert`], on a reusable symbolic analysis [`QepSymbolic`]) and the real
 //! squared transformation of an undamped problem ([`QepSquaredShift`]).
 
-use super::vector::{spmv_complex, spmv_complex_add};
+use super::vector::{spmv_complex, spmv_complex_add, spmv_complex_split};
 use super::{check_qep, ComplexLinOp, Qep};
 use crate::contact::FrictionalOperator;
 use crate::{c64, Error, Result, SparseMat, SparseRef};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, Triplet};
-use faer::{Mat, MatMut};
+use faer::MatMut;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Symbolic sparse LU analysis of `Q(sigma) = sigma^2 M + sigma C + K` on the union of
@@ -349,18 +349,7 @@ impl ComplexLinOp for QepSquaredShift<'_> {
         let n = self.qep.dim();
         assert_eq!(x.len(), n, "QepSquaredShift::apply: x has the wrong length");
         assert_eq!(y.len(), n, "QepSquaredShift::apply: y has the wrong length");
-        let mut b = Mat::<f64>::zeros(n, 2);
-        let m = self.qep.m.as_ref();
-        for j in 0..n {
-            let (xr, xi) = (x[j].re, x[j].im);
-            if xr == 0.0 && xi == 0.0 {
-                continue;
-            }
-            for (i, v) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
-                b[(i, 0)] += v * xr;
-                b[(i, 1)] += v * xi;
-            }
-        }
+        let mut b = spmv_complex_split(self.qep.m.as_ref(), x);
         self.lu.solve_in_place(b.as_mut());
         for (i, v) in y.iter_mut().enumerate() {
             *v = c64::new(b[(i, 0)], b[(i, 1)]);
