@@ -194,3 +194,53 @@ fn the_second_order_directions_sharpen_the_ritz_step() {
     assert!(df2 < 0.5 * df1, "df/f {df2:e} vs {df1:e}");
     assert!(ddvr2 < ddvr1, "dDvR {ddvr2:e} vs {ddvr1:e}");
 }
+
+#[test]
+fn a_prepared_model_computes_its_free_modes_and_synthesis_once() {
+    let (reg, prep) = setup();
+    let arpack = reg.eigen.create("arpack", &Params::new()).unwrap();
+    // the highest cutoff first: a lower one is its leading part, bit for bit
+    let high = prep.normal_modes(arpack.as_ref(), 30_000.0, 1e-10).unwrap();
+    let low = prep.normal_modes(arpack.as_ref(), 12_000.0, 1e-10).unwrap();
+    assert!(!low.freq_hz.is_empty() && low.freq_hz.len() < high.freq_hz.len());
+    assert!(low.freq_hz.iter().all(|&f| f <= 12_000.0));
+    assert!(high.freq_hz[low.freq_hz.len()] > 12_000.0);
+    assert_eq!(low.freq_hz[..], high.freq_hz[..low.freq_hz.len()]);
+    assert_eq!(
+        low.vectors.as_ref(),
+        high.vectors.as_ref().subcols(0, low.freq_hz.len())
+    );
+    // two methods on the same model share one synthesis ...
+    let cms = || Method::new(&reg, "cms", &Params::new(), "dense", "arpack", params()).unwrap();
+    let (mut a, mut b) = (cms(), cms());
+    let fa = a.prepare_free_interface_on(&prep).unwrap().unwrap();
+    let fb = b.prepare_free_interface_on(&prep).unwrap().unwrap();
+    assert!(std::sync::Arc::ptr_eq(&fa, &fb));
+    // ... which, built on the condensation's factor of K, synthesizes what one built
+    // from scratch does
+    let fresh = cms()
+        .prepare_free_interface(&prep.model, &prep.set)
+        .unwrap()
+        .unwrap();
+    assert_eq!(fa.modes(), fresh.modes());
+    let all: Vec<usize> = (0..fa.pairs()).collect();
+    let mut sa: Vec<f64> = fa
+        .synthesize(&all, 0.4)
+        .unwrap()
+        .s
+        .iter()
+        .map(|s| s.re)
+        .collect();
+    let mut sf: Vec<f64> = fresh
+        .synthesize(&all, 0.4)
+        .unwrap()
+        .s
+        .iter()
+        .map(|s| s.re)
+        .collect();
+    sa.sort_by(f64::total_cmp);
+    sf.sort_by(f64::total_cmp);
+    for (x, y) in sa.iter().zip(&sf) {
+        assert!((x - y).abs() <= 1e-9 * y.abs().max(1.0), "{x} vs {y}");
+    }
+}

@@ -17,6 +17,7 @@
 //! tracking, which then starts new branches rather than joining wrong ones).
 
 use crate::pipeline::{FreeModes, Method, PipelineError, Prepared, Result, StepResult};
+use crate::profile::Profile;
 use crate::sweep::{
     active_hash, couplings, signature, track, Branch, Checkpoint, SweepMode, SweepPoint,
     TrackOptions,
@@ -256,8 +257,31 @@ pub fn sweep_points(
     values: &[f64],
     reference: &FreeModes,
     checkpoint: Option<&Checkpoint>,
+    solve: impl FnMut(f64, &FrictionalOperator, f64, bool) -> Result<StepResult>,
+    progress: impl FnMut(&SweepPoint),
+) -> Result<Vec<SweepPoint>> {
+    let mut profile = Profile::new();
+    sweep_points_profiled(
+        family,
+        values,
+        reference,
+        checkpoint,
+        solve,
+        progress,
+        &mut profile,
+    )
+}
+
+/// [`sweep_points`], adding the time of the equilibria, the operators' assembly (when
+/// the contact set changed) and the signatures of the points computed to `profile`.
+pub fn sweep_points_profiled(
+    family: &mut dyn OperatorFamily,
+    values: &[f64],
+    reference: &FreeModes,
+    checkpoint: Option<&Checkpoint>,
     mut solve: impl FnMut(f64, &FrictionalOperator, f64, bool) -> Result<StepResult>,
     mut progress: impl FnMut(&SweepPoint),
+    profile: &mut Profile,
 ) -> Result<Vec<SweepPoint>> {
     let done = match checkpoint {
         Some(c) => c.load().map_err(|e| PipelineError::Core {
@@ -278,8 +302,16 @@ pub fn sweep_points(
             continue;
         }
         let m = family.member(value)?;
+        if m.times_s[0] > 0.0 {
+            profile.add("equilibrium", m.times_s[0]);
+        }
+        if m.changed {
+            profile.add("operator assembly", m.times_s[1]);
+        }
         let (modes, basis_size, basis_time) = solve(value, m.op, m.mu, m.changed)?;
+        let t = Instant::now();
         let mut pt = sweep_point(m.op, &modes, reference, value, m.mu, m.active_pairs);
+        profile.add("signatures", t.elapsed().as_secs_f64());
         pt.active_hash = m.active_hash;
         pt.rebuilt = prev_hash != Some(pt.active_hash);
         pt.basis_size = basis_size;
@@ -327,6 +359,8 @@ pub struct FamilySweep {
     pub kept: Vec<(f64, ComplexModes)>,
     /// Wall time (s).
     pub time_s: f64,
+    /// Where the time of the points computed in this run went.
+    pub profile: Profile,
 }
 
 /// Runs `method` over `values` of `family` (signatures on `reference`), then tracks the
@@ -346,14 +380,38 @@ pub fn run_family_sweep(
 ) -> Result<FamilySweep> {
     let start = Instant::now();
     let mut kept = Vec::new();
+    let mut solves = Profile::new();
     let step = |value: f64, op: &FrictionalOperator, mu: f64, changed: bool| {
         let out = method.solve(op, mu, changed)?;
+        let t = method.last_times();
+        for (stage, s) in [
+            ("basis", t.basis_s),
+            ("projection", t.projection_s),
+            ("eigen solve", t.solve_s),
+            ("expansion + backward errors", t.expansion_s),
+            ("condition numbers", t.condition_s),
+        ] {
+            if s > 0.0 {
+                solves.add(stage, s);
+            }
+        }
         if keep_modes_at.iter().any(|&k| (k - value).abs() <= 1e-9) {
             kept.push((value, out.0.clone()));
         }
         Ok(out)
     };
-    let points = sweep_points(family, values, reference, checkpoint, step, progress)?;
+    let mut profile = Profile::new();
+    let points = sweep_points_profiled(
+        family,
+        values,
+        reference,
+        checkpoint,
+        step,
+        progress,
+        &mut profile,
+    )?;
+    profile.extend_prefixed("", &solves);
+    let t = Instant::now();
     let branches = track(&points, &TrackOptions::default());
     let couplings = couplings(&points, &branches, dvr_tol)
         .iter()
@@ -366,12 +424,14 @@ pub fn run_family_sweep(
             makeup: makeup(&points, &branches[c.partners[0]], reference),
         })
         .collect();
+    profile.add("tracking + couplings", t.elapsed().as_secs_f64());
     Ok(FamilySweep {
         points,
         branches,
         couplings,
         kept,
         time_s: start.elapsed().as_secs_f64(),
+        profile,
     })
 }
 

@@ -6,7 +6,7 @@
 //! values ([`reference`](mod@reference)), method benchmarks ([`bench`](mod@bench)),
 //! sweeps over mu or any parameter of an operator family ([`sweep`], [`family`],
 //! [`mu_sweep`]) and long studies over contact zones ([`study`]), with their
-//! JSON-lines records ([`jsonl`]).
+//! JSON-lines records ([`jsonl`]) and where their time went ([`profile`]).
 
 pub mod bench;
 pub mod calibrate;
@@ -16,6 +16,7 @@ pub mod labels;
 pub mod modal;
 pub mod mu_sweep;
 pub mod pipeline;
+pub mod profile;
 pub mod reference;
 pub mod study;
 pub mod sweep;

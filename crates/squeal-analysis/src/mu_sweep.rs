@@ -6,6 +6,7 @@
 
 use crate::family::{run_family_sweep, SceneMu};
 use crate::pipeline::{FreeModes, Method, Prepared, Result};
+use crate::profile::Profile;
 use crate::sweep::{Branch, Checkpoint, SweepPoint};
 use serde::Serialize;
 use squeal_core::{EigenParams, Params, Registry};
@@ -139,6 +140,9 @@ pub struct MuSweep {
     pub kept: Vec<(f64, squeal_core::qep::ComplexModes)>,
     /// Wall time (s).
     pub time_s: f64,
+    /// Where it went: the free model's modes and synthesis, then the stages of the points
+    /// computed in this run.
+    pub profile: Profile,
 }
 
 /// Runs the sweep `s` on `prep`; finished points go to `checkpoint` (a resumed sweep
@@ -151,7 +155,6 @@ pub fn run_sweep(
     progress: impl FnMut(&SweepPoint),
 ) -> Result<MuSweep> {
     let start = Instant::now();
-    let free = prep.free_interface_modes(registry, "arpack", 1.5 * s.band_hz[1])?;
     let params = EigenParams {
         fmin_hz: s.band_hz[0],
         fmax_hz: s.band_hz[1],
@@ -167,7 +170,15 @@ pub fn run_sweep(
         params,
     )?;
     method.set_condition(s.condition);
-    method.prepare_free_interface(&prep.model, &prep.set)?;
+    let mut profile = Profile::new();
+    // the synthesis first: its modes, up to a higher cutoff, serve the tracking too
+    let t = Instant::now();
+    if method.prepare_free_interface_on(prep)?.is_some() {
+        profile.add("free-interface synthesis", t.elapsed().as_secs_f64());
+    }
+    let t = Instant::now();
+    let free = prep.free_interface_modes(registry, "arpack", 1.5 * s.band_hz[1])?;
+    profile.add("free modes of tracking", t.elapsed().as_secs_f64());
     let mut family = SceneMu::new(prep, registry, &s.equilibrium, &s.law);
     let sweep = run_family_sweep(
         &mut family,
@@ -191,6 +202,7 @@ pub fn run_sweep(
             free_interface_mac: c.makeup,
         })
         .collect();
+    profile.extend_prefixed("", &sweep.profile);
     Ok(MuSweep {
         points: sweep.points,
         branches: sweep.branches,
@@ -198,6 +210,7 @@ pub fn run_sweep(
         free,
         kept: sweep.kept,
         time_s: start.elapsed().as_secs_f64(),
+        profile,
     })
 }
 

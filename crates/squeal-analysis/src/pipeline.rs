@@ -9,11 +9,11 @@ use squeal_contact::{
 use squeal_core::contact::Condensation;
 use squeal_core::qep::ComplexModes;
 use squeal_core::{
-    EigenParams, EigenSolver, FreeInterface, FrictionalOperator, PairDofs, Params, Registry,
-    SymmetricProblem,
+    EigenParams, EigenSolver, FreeInterface, FrictionalOperator, PairDofs, Params, RealModes,
+    Registry, SymmetricProblem,
 };
 use squeal_scene::{build, BodyKind, Damping, Model, Scene, SceneError};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 use thiserror::Error;
 
@@ -68,6 +68,31 @@ pub struct Prepared {
     pub g0: Vec<f64>,
     /// Build time (s).
     pub build_time_s: f64,
+    /// The free model's normal modes and free-interface synthesis, computed once.
+    free: Mutex<FreeCache>,
+}
+
+/// What [`Prepared`] keeps of the free (unconstrained) model between stages: its normal
+/// modes up to the highest frequency asked so far, and its free-interface synthesis on the
+/// candidate pairs (which takes the condensation's factor of `K`).
+#[derive(Default)]
+struct FreeCache {
+    /// Modes complete up to `.0` Hz at tolerance `.1`.
+    modes: Option<(f64, f64, Arc<RealModes>)>,
+    /// Synthesis from the modes up to `.0` Hz.
+    synthesis: Option<(f64, Arc<FreeInterface>)>,
+}
+
+/// The modes of `modes` up to `fmax_hz` (they are sorted by frequency).
+fn modes_below(modes: &RealModes, fmax_hz: f64) -> RealModes {
+    let k = modes.freq_hz.iter().take_while(|&&f| f <= fmax_hz).count();
+    RealModes {
+        omega2: modes.omega2[..k].to_vec(),
+        freq_hz: modes.freq_hz[..k].to_vec(),
+        vectors: modes.vectors.as_ref().subcols(0, k).to_owned(),
+        residuals: modes.residuals[..k].to_vec(),
+        info: modes.info.clone(),
+    }
 }
 
 impl Prepared {
@@ -89,7 +114,81 @@ impl Prepared {
             f,
             g0,
             build_time_s,
+            free: Mutex::new(FreeCache::default()),
         })
+    }
+
+    /// The normal modes of the free model (no pair tied) up to `fmax_hz`, by `solver` at
+    /// relative tolerance `tol`. Computed once: a later call up to the same or a lower
+    /// frequency, at the same or a looser tolerance, takes them from the first (callers
+    /// that need several cutoffs ask for the highest first).
+    pub fn normal_modes(
+        &self,
+        solver: &dyn EigenSolver,
+        fmax_hz: f64,
+        tol: f64,
+    ) -> Result<RealModes> {
+        let mut cache = self.free.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some((top, t, modes)) = &cache.modes {
+            if *top >= fmax_hz && *t <= tol {
+                return Ok(modes_below(modes, fmax_hz));
+            }
+        }
+        let modes = solver
+            .solve_symmetric(
+                &SymmetricProblem {
+                    k: self.model.k.as_ref(),
+                    m: self.model.m.as_ref(),
+                },
+                &EigenParams {
+                    fmin_hz: 0.0,
+                    fmax_hz,
+                    tol,
+                    nev_hint: None,
+                    ..EigenParams::default()
+                },
+            )
+            .map_err(core("normal modes of the free model"))?;
+        cache.modes = Some((fmax_hz, tol, Arc::new(modes.clone())));
+        Ok(modes)
+    }
+
+    /// The free-interface synthesis of the model on its candidate pairs
+    /// ([`squeal_core::synthesis`]) from the normal modes up to `cutoff_hz` (by `modal` at
+    /// the tolerance of `params`), on the condensation's factor of `K`. Built once per
+    /// cutoff and shared.
+    pub fn free_interface(
+        &self,
+        modal: &dyn EigenSolver,
+        params: &EigenParams,
+        cutoff_hz: f64,
+    ) -> Result<Arc<FreeInterface>> {
+        if let Some((c, fi)) = &self
+            .free
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .synthesis
+        {
+            if *c == cutoff_hz {
+                return Ok(fi.clone());
+            }
+        }
+        let modes = self.normal_modes(modal, cutoff_hz, params.tol)?;
+        let fi = Arc::new(
+            FreeInterface::with_factor(
+                self.model.k.as_ref(),
+                self.model.m.as_ref(),
+                &pair_dofs(&self.set),
+                &modes,
+                self.condensation.factor().clone(),
+            )
+            .map_err(core("free-interface synthesis"))?,
+        );
+        self.free
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .synthesis = Some((cutoff_hz, fi.clone()));
+        Ok(fi)
     }
 
     /// The sliding equilibrium at `mu` under the scene's load.
@@ -182,15 +281,19 @@ pub fn free_interface(
             },
         )
         .map_err(core("free-interface modes of the synthesis"))?;
-    let pairs: Vec<PairDofs> = (0..set.len())
+    FreeInterface::new(model.k.as_ref(), model.m.as_ref(), &pair_dofs(set), &modes)
+        .map_err(core("free-interface synthesis"))
+}
+
+/// The DOFs of the candidate pairs of `set`, in the synthesis's terms.
+fn pair_dofs(set: &ContactSet) -> Vec<PairDofs> {
+    (0..set.len())
         .map(|i| PairDofs {
             pin: set.pin_dofs[i],
             disc: set.disc_dofs[i],
             direction: set.direction[i],
         })
-        .collect();
-    FreeInterface::new(model.k.as_ref(), model.m.as_ref(), &pairs, &modes)
-        .map_err(core("free-interface synthesis"))
+        .collect()
 }
 
 /// Complex modes of `op` at `mu` with the named eigen solver, timed.
@@ -224,8 +327,14 @@ pub struct FreeModes {
     pub mphi: squeal_core::faer::Mat<f64>,
 }
 
+/// Relative tolerance of the free-interface modes of tracking (their signatures only
+/// need a few digits; the free-interface synthesis of `cms` at the default tolerance
+/// serves them).
+pub const TRACKING_TOL: f64 = 1e-10;
+
 impl Prepared {
-    /// Normal modes of the bodies without contact up to `fmax_hz`.
+    /// Normal modes of the bodies without contact up to `fmax_hz` (from
+    /// [`Prepared::normal_modes`]: a synthesis built before serves them).
     pub fn free_interface_modes(
         &self,
         registry: &Registry,
@@ -236,12 +345,8 @@ impl Prepared {
             .eigen
             .create(eigen, &Params::new())
             .map_err(core("eigen solver"))?;
-        let params = EigenParams {
-            fmax_hz,
-            ..EigenParams::default()
-        };
-        let (modes, records) = crate::modal::normal_modes(&self.model, solver.as_ref(), &params)
-            .map_err(core("free-interface modes"))?;
+        let modes = self.normal_modes(solver.as_ref(), fmax_hz, TRACKING_TOL)?;
+        let records = crate::modal::label_modes(&self.model, &modes);
         let n = self.model.m.nrows();
         let k = modes.freq_hz.len();
         let mut mphi = squeal_core::faer::Mat::<f64>::zeros(n, k);
@@ -417,6 +522,22 @@ impl Method {
         if self.free.is_none() {
             let fi = free_interface(model, set, self.modal.as_ref(), &self.params, cutoff)?;
             self.free = Some(Arc::new(fi));
+        }
+        Ok(self.free.clone())
+    }
+
+    /// [`prepare_free_interface`](Self::prepare_free_interface) from the synthesis
+    /// `prep` keeps (built there once, on the condensation's factor of `K`, and shared
+    /// with every method and stage on the same scene).
+    pub fn prepare_free_interface_on(
+        &mut self,
+        prep: &Prepared,
+    ) -> Result<Option<Arc<FreeInterface>>> {
+        let Some(cutoff) = self.free_interface_cutoff() else {
+            return Ok(None);
+        };
+        if self.free.is_none() {
+            self.free = Some(prep.free_interface(self.modal.as_ref(), &self.params, cutoff)?);
         }
         Ok(self.free.clone())
     }

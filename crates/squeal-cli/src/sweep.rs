@@ -9,6 +9,7 @@ use squeal_analysis::mu_sweep::{
     mu_list, run_sweep, value_list, CouplingReport, MuSweep, MuSweepSettings,
 };
 use squeal_analysis::pipeline::{FreeModes, Method, Prepared};
+use squeal_analysis::profile::{peak_rss_mb, Profile, StageTime};
 use squeal_analysis::sweep::{Branch, Checkpoint, SweepPoint};
 use squeal_core::{EigenParams, Registry};
 use std::io::Write;
@@ -444,6 +445,10 @@ pub struct Summary {
     pub free_interface_modes: usize,
     pub time_s: f64,
     pub couplings: Vec<CouplingReport>,
+    /// Where the time went (points read back from a checkpoint excluded).
+    pub stages: Vec<StageTime>,
+    /// Peak resident memory of the process (MB).
+    pub peak_rss_mb: Option<f64>,
 }
 
 /// The range rule of every mu list (`--from/--to/--step`).
@@ -457,6 +462,9 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<Summary> {
     let band = a.band.unwrap_or(scene.study.band_hz);
     crate::opts::check_band_against(band, &scene)?;
     let prep = Prepared::new(registry, scene, &file)?;
+    let mut setup = Profile::new();
+    setup.add("model build", prep.build_time_s);
+    setup.add("contact condensation", prep.condensation.time_s);
     let settings = MuSweepSettings {
         basis_params: crate::opts::parse_params(a.basis_opts)?,
         eigen: a.eigen.into(),
@@ -474,12 +482,14 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<Summary> {
         [a.from, a.to, a.step],
         a.out,
         a.resume,
+        &setup,
     )?
     .0)
 }
 
 /// Runs the sweep `settings` of `prep` into `out` (checkpoint, CSV, charts, summary):
-/// the command's work, shared with `validate`. `range` is `[from, to, step]` as given.
+/// the command's work, shared with `validate`. `range` is `[from, to, step]` as given;
+/// `setup` holds the stages run before (building `prep`), reported first.
 pub fn run_on(
     registry: &Registry,
     prep: &Prepared,
@@ -487,6 +497,7 @@ pub fn run_on(
     range: [f64; 3],
     out: &Path,
     resume: bool,
+    setup: &Profile,
 ) -> Result<(Summary, MuSweep)> {
     let start = Instant::now();
     // the points depend on these (not on the mu list: shards and extensions share them)
@@ -507,6 +518,13 @@ pub fn run_on(
     let (ckpt, done) = open_checkpoint(out, "sweep mu", "a mu sweep", resume, &inputs)?;
     let mut eta = crate::opts::Eta::new(settings.mus.len(), done);
     let dvr_tol = settings.dvr_tol;
+    if done < settings.mus.len() {
+        eprintln!(
+            "free modes of the model (and the free-interface synthesis a basis such as `cms` \
+             works from) up to the needed cutoff: {} DOFs, the longest setup stage",
+            prep.model.dofs.n_free()
+        );
+    }
     let sweep = run_sweep(registry, prep, settings, Some(&ckpt), |p| {
         let unstable = p.modes.iter().filter(|m| m.dvr > dvr_tol).count();
         eprintln!(
@@ -537,6 +555,10 @@ pub fn run_on(
         })
         .collect();
     mac_charts(out, &Axis::mu(), &makeup)?;
+    let mut profile = setup.clone();
+    profile.extend_prefixed("", &sweep.profile);
+    let wall = start.elapsed().as_secs_f64() + setup.total_s();
+    eprintln!("\nwhere the time went:\n{}", profile.markdown(wall));
     let summary = Summary {
         scene: prep.file.clone(),
         units: "SI: frequencies in Hz, DvR = Re/Im (dimensionless), times in s",
@@ -559,6 +581,8 @@ pub fn run_on(
         free_interface_modes: free.freq_hz.len(),
         time_s: start.elapsed().as_secs_f64(),
         couplings: sweep.couplings.clone(),
+        stages: profile.stages,
+        peak_rss_mb: peak_rss_mb(),
     };
     std::fs::write(
         out.join("summary.json"),

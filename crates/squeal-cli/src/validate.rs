@@ -18,6 +18,7 @@ use serde::Serialize;
 use squeal_analysis::bench::{compare, ModeErrors};
 use squeal_analysis::mu_sweep::{matching_coupling, mu_list, MuSweepSettings};
 use squeal_analysis::pipeline::{Method, Prepared};
+use squeal_analysis::profile::{peak_rss_mb, Profile};
 use squeal_analysis::reference::paper;
 use squeal_core::{EigenParams, Registry};
 use std::fmt::Write as _;
@@ -217,32 +218,16 @@ struct RefRow {
     reference_time_s: f64,
 }
 
-/// The time of one stage.
-#[derive(Serialize)]
-struct Stage {
-    stage: String,
-    time_s: f64,
-}
-
-/// Peak resident memory of the process (MB), from `/proc/self/status` (`VmHWM`).
-pub fn peak_rss_mb() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = text.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb / 1024.0)
-}
-
 pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
     let start = Instant::now();
     crate::opts::claim_out(a.out, "validate")?;
     crate::opts::set_resume_hint(a.out);
-    let mut stages: Vec<Stage> = Vec::new();
+    let mut profile = Profile::new();
+    // the sub-stages of each sweep, listed after the stages
+    let mut detail = Profile::new();
     let mut lap = Instant::now();
     let mut stage = |name: &str, lap: &mut Instant| {
-        stages.push(Stage {
-            stage: name.into(),
-            time_s: lap.elapsed().as_secs_f64(),
-        });
+        profile.add(name, lap.elapsed().as_secs_f64());
         *lap = Instant::now();
     };
     let mut md = String::new();
@@ -396,8 +381,15 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
                 band,
             )
         };
-        let (s, sweep) =
-            crate::sweep::run_on(registry, &prep, &settings, [0.0, 0.8, *step], &out, true)?;
+        let (s, sweep) = crate::sweep::run_on(
+            registry,
+            &prep,
+            &settings,
+            [0.0, 0.8, *step],
+            &out,
+            true,
+            &Profile::new(),
+        )?;
         for c in &p.couplings {
             let best = matching_coupling(&s.couplings, c.freq_hz);
             paper_rows.push(PaperRow {
@@ -411,6 +403,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
                 made_of: best.map_or(Vec::new(), |c| c.free_interface_mac.clone()),
             });
         }
+        detail.extend_prefixed(&format!("sweep {basis}: "), &sweep.profile);
         kept.push((basis.clone(), sweep.kept));
         summaries.push((basis.clone(), *step, s));
         stage(&format!("sweep {basis} (step {step})"), &mut lap);
@@ -452,7 +445,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
                         "arpack",
                         params.clone(),
                     )?;
-                    method.prepare_free_interface(&prep.model, &prep.set)?;
+                    method.prepare_free_interface_on(&prep)?;
                     method.solve(&op, mu, true)?.0
                 }
             };
@@ -534,14 +527,9 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
     let total = start.elapsed().as_secs_f64();
     let _ = writeln!(
         md,
-        "## 6. Paper vs squeal\n\n```\n{table}```\n\n## Where the time went\n\n| stage | time (s) |\n|---|---|"
-    );
-    for s in &stages {
-        let _ = writeln!(md, "| {} | {:.1} |", s.stage, s.time_s);
-    }
-    let _ = writeln!(
-        md,
-        "| total | {total:.1} |\n\nPeak resident memory: {}.",
+        "## 6. Paper vs squeal\n\n```\n{table}```\n\n## Where the time went\n\n{}| total | | {total:.1} | |\n\nInside the sweeps (points read back from a checkpoint excluded):\n\n{}\nPeak resident memory: {}.",
+        profile.markdown(total),
+        detail.markdown(total),
         peak.map_or("not measured".into(), |m| format!("{m:.0} MB"))
     );
     std::fs::write(a.out.join("report.md"), &md)?;
@@ -557,7 +545,8 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
         "sweeps": summaries.iter().map(|(b, st, s)| serde_json::json!({"basis": b, "step": st, "summary": s})).collect::<Vec<_>>(),
         "reference": refs,
         "paper_vs_squeal": paper_rows,
-        "stages": stages,
+        "stages": profile.stages,
+        "sweep_stages": detail.stages,
         "peak_rss_mb": peak,
         "time_s": total,
     });

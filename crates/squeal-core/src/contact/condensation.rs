@@ -6,13 +6,14 @@ use crate::linalg::{norm2, spmv, Cholesky};
 use crate::{Error, Result, SparseMat, SparseRef};
 use faer::sparse::Triplet;
 use faer::Mat;
+use std::sync::Arc;
 
 /// The contact problem condensed on the pairs after one Cholesky factorization of `K`:
 /// gaps `g = q + (W + mu Wnt) Rn` with `q = g0 + Pn K^-1 F`, `W = Pn K^-1 Pn^T` and
 /// `Wnt = Pn K^-1 Pt^T` (contact flexibilities, m/N). Shared by every equilibrium
 /// solver; it keeps the factorization to recover displacements.
 pub struct Condensation {
-    factor: Cholesky,
+    factor: Arc<Cholesky>,
     /// `W = Pn K^-1 Pn^T` (m/N), symmetric positive definite.
     pub w: Mat<f64>,
     /// `Wnt = Pn K^-1 Pt^T` (m/N).
@@ -59,12 +60,18 @@ impl Condensation {
         spmv(problem.pn, &kf, &mut q);
         q.iter_mut().zip(problem.g0).for_each(|(a, b)| *a += b);
         Ok(Self {
-            factor,
+            factor: Arc::new(factor),
             w,
             wnt,
             q,
             time_s: start.elapsed().as_secs_f64(),
         })
+    }
+
+    /// The Cholesky factor of `K`, shared (a free-interface synthesis of the same model
+    /// takes it instead of factorizing `K` again).
+    pub fn factor(&self) -> &Arc<Cholesky> {
+        &self.factor
     }
 
     /// Number of pairs.

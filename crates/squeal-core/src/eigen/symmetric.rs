@@ -110,7 +110,7 @@ pub fn solve_symmetric_band(
                 }
                 break (lam, out.vectors);
             }
-            let grown = (nev * 2).min(n - 1);
+            let grown = grown_nev(nev, &lam, sigma, top).min(n - 1);
             if grown > params.max_modes {
                 return Err(too_many_modes(params));
             }
@@ -124,6 +124,28 @@ pub fn solve_symmetric_band(
     let mut modes = finish_real_modes(problem, &omega2, vectors.as_ref(), params, info);
     modes.info.time_s = start.elapsed().as_secs_f64();
     Ok(modes)
+}
+
+/// The number of pairs to ask for when the `nev` eigenvalues `lam` (all converged) lie
+/// below the band top `top` (both `omega^2`, shift `sigma`): Weyl's law for a 3D solid,
+/// `N(omega^2) ~ (omega^2 - sigma)^(3/2)` (thin parts grow slower, so it overestimates),
+/// from the highest converged eigenvalue to the band top with a 20 % margin, at least
+/// 1.5x and at most 4x `nev`. A rerun starts Lanczos afresh, so asking for too few costs a
+/// whole run while asking for a few too many costs a larger basis.
+fn grown_nev(nev: usize, lam: &[f64], sigma: f64, top: f64) -> usize {
+    let highest = lam.iter().fold(f64::NEG_INFINITY, |a, &l| a.max(l));
+    let lo = (3 * nev).div_ceil(2);
+    let hi = 4 * nev;
+    if !(highest.is_finite() && highest > sigma) {
+        return hi;
+    }
+    let ratio = ((top - sigma) / (highest - sigma)).max(1.0);
+    let estimate = (1.2 * nev as f64 * ratio.powf(1.5)).ceil();
+    if estimate.is_finite() {
+        (estimate as usize).clamp(lo, hi)
+    } else {
+        hi
+    }
 }
 
 /// Finishing step shared by every symmetric backend: keeps the pairs with
@@ -222,4 +244,33 @@ pub fn dense_symmetric(problem: &SymmetricProblem<'_>) -> Result<(Vec<f64>, Mat<
         faer::Par::Seq,
     );
     Ok((lam, x))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::grown_nev;
+
+    fn w2(f_hz: f64) -> f64 {
+        (2.0 * std::f64::consts::PI * f_hz).powi(2)
+    }
+
+    #[test]
+    fn grown_nev_follows_weyl_within_bounds() {
+        let sigma = -w2(750.0);
+        let top = w2(15_000.0);
+        // the highest converged mode near the top: the smallest growth
+        assert_eq!(grown_nev(24, &[w2(100.0), w2(14_900.0)], sigma, top), 36);
+        // two thirds of the way in frequency: (1.5^2)^1.5 = 3.4, times 1.2
+        let mid = grown_nev(24, &[w2(10_000.0)], sigma, top);
+        assert!((90..=96).contains(&mid), "{mid}");
+        // far below the top: capped at 4x
+        assert_eq!(grown_nev(24, &[w2(1_000.0)], sigma, top), 96);
+        // no usable eigenvalue: the cap
+        assert_eq!(grown_nev(10, &[], sigma, top), 40);
+        assert_eq!(grown_nev(10, &[f64::NAN], sigma, top), 40);
+        // more converged modes never ask for fewer
+        let a = grown_nev(24, &[w2(12_000.0)], sigma, top);
+        let b = grown_nev(24, &[w2(9_000.0)], sigma, top);
+        assert!(b >= a, "{a} {b}");
+    }
 }

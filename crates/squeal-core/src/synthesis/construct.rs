@@ -8,6 +8,7 @@ use crate::linalg::Cholesky;
 use crate::{Error, Result, SparseMat, SparseRef};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// `K^-1` in place on the columns of `x`, `BLOCK` at a time (bounded workspace).
@@ -46,6 +47,32 @@ impl FreeInterface {
         m: SparseRef<'_>,
         pairs: &[PairDofs],
         modes: &RealModes,
+        store_limit_bytes: usize,
+    ) -> Result<Self> {
+        Self::build(k, m, pairs, modes, None, store_limit_bytes)
+    }
+
+    /// [`FreeInterface::new`] with the Cholesky factor of the same `K` already computed
+    /// (by the contact condensation of the model, [`Condensation::factor`]): no second
+    /// factorization.
+    ///
+    /// [`Condensation::factor`]: crate::contact::Condensation::factor
+    pub fn with_factor(
+        k: SparseRef<'_>,
+        m: SparseRef<'_>,
+        pairs: &[PairDofs],
+        modes: &RealModes,
+        factor: Arc<Cholesky>,
+    ) -> Result<Self> {
+        Self::build(k, m, pairs, modes, Some(factor), STORE_LIMIT_BYTES)
+    }
+
+    fn build(
+        k: SparseRef<'_>,
+        m: SparseRef<'_>,
+        pairs: &[PairDofs],
+        modes: &RealModes,
+        factor: Option<Arc<Cholesky>>,
         store_limit_bytes: usize,
     ) -> Result<Self> {
         let start = Instant::now();
@@ -89,7 +116,17 @@ impl FreeInterface {
                 )));
             }
         }
-        let factor = Cholesky::new(k, "K (free-interface synthesis)")?;
+        let factor = match factor {
+            Some(f) if f.dim() == n => f,
+            Some(f) => {
+                return Err(Error::Dimension {
+                    context: "free-interface synthesis: the given factor of K".into(),
+                    expected: n,
+                    got: f.dim(),
+                })
+            }
+            None => Arc::new(Cholesky::new(k, "K (free-interface synthesis)")?),
+        };
         let pn_rows = |x: MatRef<'_, f64>| {
             Mat::from_fn(nr, x.ncols(), |i, c| {
                 x[(pairs[i].pin[2], c)] - x[(pairs[i].disc[2], c)]

@@ -32,6 +32,7 @@
 use crate::linalg::Cholesky;
 use crate::SparseMat;
 use faer::{Mat, Par};
+use std::sync::Arc;
 
 mod construct;
 mod expand;
@@ -60,7 +61,7 @@ pub struct FreeInterface {
     omega2: Vec<f64>,
     /// Cholesky factor of `K`: the static responses `K^-1 (Pn^T | Pt^T) r` of the
     /// expansion, solved for the modes expanded (when they are not stored).
-    factor: Cholesky,
+    factor: Arc<Cholesky>,
     /// The static responses of every candidate pair, stored when they fit the memory
     /// limit: faster expansions, `4 n nR` values.
     stored: Option<Stored>,
