@@ -279,6 +279,15 @@ fn execute(
         report.timings.mean.expansion_s,
         start.elapsed().as_secs_f64()
     );
+    if report.computed > 0 {
+        println!(
+            "\nwhere this run's time went (case stages summed over the workers):\n{}peak \
+             resident memory: {}",
+            report.profile.markdown(start.elapsed().as_secs_f64()),
+            squeal_analysis::profile::peak_rss_mb()
+                .map_or("not measured".into(), |m| format!("{m:.0} MB"))
+        );
+    }
     finish_outputs(&dir, &def, o.no_charts)
 }
 

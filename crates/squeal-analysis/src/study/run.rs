@@ -5,6 +5,7 @@ use super::summary::{summarize, Summary, TimingSummary};
 use super::{files, input, Case, CaseList, Result, Shard, SolveSpec, StudyDef, StudyError};
 use crate::jsonl;
 use crate::pipeline::{damped_operator, Method, PipelineError};
+use crate::profile::Profile;
 use serde::{Deserialize, Serialize};
 use squeal_contact::ContactSet;
 use squeal_core::Registry;
@@ -224,6 +225,9 @@ pub struct RunReport {
     pub summary: Summary,
     /// The timings summary written.
     pub timings: TimingSummary,
+    /// Where this run's time went: the free-interface synthesis (when the basis works
+    /// from one), then each stage summed over the cases computed now.
+    pub profile: Profile,
 }
 
 /// Writes `study.json`, or checks an existing one is the same study.
@@ -327,12 +331,16 @@ pub fn run(
     todo.truncate(limit);
     // a basis working from the free-interface synthesis (`cms`) gets one, built here once
     // for every pair of the face and shared by the workers
+    let mut profile = Profile::new();
     let free = if todo.is_empty() || probe.free_interface_cutoff().is_none() {
         None
     } else {
+        let t = std::time::Instant::now();
         let all = ContactSet::new(model, &squeal_scene::Zone::Uniform, def.rotation)
             .map_err(PipelineError::from)?;
-        probe.prepare_free_interface(model, &all)?
+        let free = probe.prepare_free_interface(model, &all)?;
+        profile.add("free-interface synthesis", t.elapsed().as_secs_f64());
+        free
     };
     drop(probe);
     progress(Progress::Start {
@@ -401,6 +409,22 @@ pub fn run(
     let computed = *counter.lock().unwrap_or_else(|p| p.into_inner());
     let records = dir.records()?;
     let timings = dir.timing_records()?;
+    let now: Vec<&Timing> = timings
+        .iter()
+        .filter(|t| todo.iter().any(|c| c.id == t.id))
+        .collect();
+    for t in &now {
+        for (stage, s) in [
+            ("contact set", t.contact_s),
+            ("operator", t.operator_s),
+            ("basis", t.basis_s),
+            ("projection", t.projection_s),
+            ("eigen solve", t.solve_s),
+            ("expansion + backward errors", t.expansion_s),
+        ] {
+            profile.add(stage, s);
+        }
+    }
     let (summary, tsum) = finalize(dir, def, &list, records, timings)?;
     Ok(RunReport {
         cases: list.cases.len(),
@@ -410,6 +434,7 @@ pub fn run(
         remaining,
         summary,
         timings: tsum,
+        profile,
     })
 }
 
