@@ -131,15 +131,12 @@ impl MuArgs {
             crate::stability::sci(s.max_error_bound),
             s.time_s
         );
-        for c in &s.couplings {
-            println!(
-                "  {:>8.1} Hz  mu {:.3}-{:.3}  max DvR {:.4}  partners {:?}",
-                c.freq_hz, c.mu_from, c.mu_to, c.max_dvr, c.partners
-            );
-        }
-        println!(
-            "wrote {}/{{sweep.csv,summary.json,*.svg,*.png}}",
-            self.out.display()
+        print_couplings(
+            "mu",
+            s.couplings
+                .iter()
+                .map(|c| (c.freq_hz, c.mu_from, c.mu_to, c.max_dvr, &c.partners[..])),
+            &self.out,
         );
         Ok(())
     }
@@ -375,18 +372,32 @@ impl ParamArgs {
             crate::stability::sci(summary.max_error_bound),
             summary.time_s
         );
-        for c in &summary.couplings {
-            println!(
-                "  {:>8.1} Hz  {name} {}-{}  max DvR {:.4}  partners {:?}",
-                c.freq_hz, c.from, c.to, c.max_dvr, c.partners
-            );
-        }
-        println!(
-            "wrote {}/{{sweep.csv,summary.json,*.svg,*.png}}",
-            out.display()
+        print_couplings(
+            name,
+            summary
+                .couplings
+                .iter()
+                .map(|c| (c.freq_hz, c.from, c.to, c.max_dvr, &c.partners[..])),
+            out,
         );
         Ok(())
     }
+}
+
+/// Prints the couplings of a sweep over `name` (frequency, first and last unstable
+/// value, largest DvR, partner branches), one a line, then the files written to `out`.
+fn print_couplings<'a>(
+    name: &str,
+    couplings: impl Iterator<Item = (f64, f64, f64, f64, &'a [usize])>,
+    out: &Path,
+) {
+    for (freq_hz, from, to, max_dvr, partners) in couplings {
+        println!(
+            "  {freq_hz:>8.1} Hz  {name} {from}-{to}  max DvR {max_dvr:.4}  partners \
+             {partners:?}"
+        );
+    }
+    println!("wrote {}/{{sweep.csv,summary.json,*.svg,*.png}}", out.display());
 }
 
 /// What the reference modes of a parameter sweep are.
