@@ -236,7 +236,9 @@ impl ContactArgs {
 /// The `[k/N, ETA ...]` prefix of progress lines: the rate of the items computed in this
 /// run (items finished before a resume count as done, not in the rate).
 pub struct Eta {
-    start: std::time::Instant,
+    /// When the first item computed in this run finished: the rate is measured from there,
+    /// so a long set-up before the first item does not inflate the estimate.
+    first: Option<std::time::Instant>,
     total: usize,
     done: usize,
     before: usize,
@@ -246,24 +248,30 @@ impl Eta {
     /// `total` items, `before` of them finished by an earlier run.
     pub fn new(total: usize, before: usize) -> Self {
         Self {
-            start: std::time::Instant::now(),
+            first: None,
             total,
             done: 0,
             before,
         }
     }
 
-    /// One more item finished: the prefix to print.
+    /// One more item finished: the prefix to print (the estimate from the second item
+    /// computed in this run on).
     pub fn tick(&mut self) -> String {
         self.done += 1;
         let k = self.done.min(self.total);
         let computed = self.done.saturating_sub(self.before);
         let left = self.total.saturating_sub(self.done);
-        if computed == 0 || left == 0 {
-            return format!("[{k}/{}]", self.total);
+        if computed == 1 {
+            self.first = Some(std::time::Instant::now());
         }
-        let per = self.start.elapsed().as_secs_f64() / computed as f64;
-        format!("[{k}/{}, ETA {}]", self.total, duration(per * left as f64))
+        match self.first {
+            Some(first) if computed >= 2 && left > 0 => {
+                let per = first.elapsed().as_secs_f64() / (computed - 1) as f64;
+                format!("[{k}/{}, ETA {}]", self.total, duration(per * left as f64))
+            }
+            _ => format!("[{k}/{}]", self.total),
+        }
     }
 }
 
@@ -434,4 +442,31 @@ pub fn read_operator_at(
     op.check_pencil()
         .map_err(|e| anyhow::anyhow!("--operator {} at {flag}: {e}", dir.display()))?;
     Ok(op)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{duration, Eta};
+
+    #[test]
+    fn eta_starts_after_the_first_item_computed_and_skips_resumed_ones() {
+        // 2 of 5 items read back from an earlier run
+        let mut eta = Eta::new(5, 2);
+        assert_eq!(eta.tick(), "[1/5]");
+        assert_eq!(eta.tick(), "[2/5]");
+        // the first computed item (its time includes any set-up): no estimate yet
+        assert_eq!(eta.tick(), "[3/5]");
+        let second = eta.tick();
+        assert!(second.starts_with("[4/5, ETA "), "{second}");
+        // the last item: nothing left to estimate
+        assert_eq!(eta.tick(), "[5/5]");
+    }
+
+    #[test]
+    fn durations_read_in_the_largest_sensible_units() {
+        assert_eq!(duration(42.4), "42 s");
+        assert_eq!(duration(200.0), "3 min 20 s");
+        assert_eq!(duration(7500.0), "2 h 05 min");
+        assert_eq!(duration(-1.0), "0 s");
+    }
 }

@@ -397,7 +397,10 @@ fn print_couplings<'a>(
              {partners:?}"
         );
     }
-    println!("wrote {}/{{sweep.csv,summary.json,*.svg,*.png}}", out.display());
+    println!(
+        "wrote {}/{{sweep.csv,summary.json,*.svg,*.png}}",
+        out.display()
+    );
 }
 
 /// What the reference modes of a parameter sweep are.
