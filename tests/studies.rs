@@ -130,6 +130,10 @@ fn an_interrupted_study_resumes_to_the_same_bytes() {
     .unwrap();
     assert_eq!((r.computed, r.remaining), (5, 7));
     assert_eq!(*seen.lock().unwrap(), [1, 2, 3, 4, 5]);
+    // the run's profile counts the cases computed now, each stage once per case
+    let eigen = r.profile.stages.iter().find(|s| s.stage == "eigen solve");
+    assert_eq!(eigen.map(|s| s.count), Some(5), "{:?}", r.profile);
+    assert!(r.profile.total_s() > 0.0);
     assert!(!r.summary.complete);
     assert_ne!(
         bytes(&part, "results.jsonl"),

@@ -158,3 +158,40 @@ fn resumed_and_sharded_sweeps_equal_the_whole() {
     assert_eq!(a, b);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_sweep_reports_where_its_time_went() {
+    use squeal::analysis::mu_sweep::{run_sweep, MuSweepSettings};
+    let reg = squeal::registry();
+    let prep = Prepared::new(&reg, coarse(), "coarse").unwrap();
+    let mus = vec![0.0, 0.3, 0.6];
+    let s = run_sweep(
+        &reg,
+        &prep,
+        &MuSweepSettings::new(mus.clone(), "cms", [0.0, 2500.0]),
+        None,
+        |_| {},
+    )
+    .unwrap();
+    let count = |name: &str| {
+        s.profile
+            .stages
+            .iter()
+            .find(|st| st.stage == name)
+            .map(|st| st.count)
+    };
+    assert_eq!(
+        count("free-interface synthesis"),
+        Some(1),
+        "{:?}",
+        s.profile
+    );
+    assert_eq!(count("free modes of tracking"), Some(1));
+    assert_eq!(count("equilibrium"), Some(mus.len()));
+    // `cms` depends on mu: a basis at every point
+    assert_eq!(count("basis"), Some(mus.len()));
+    assert_eq!(count("eigen solve"), Some(mus.len()));
+    let rebuilt = s.points.iter().filter(|p| p.rebuilt).count();
+    assert_eq!(count("operator assembly"), Some(rebuilt));
+    assert!(s.profile.total_s() <= s.time_s + 1e-9);
+}
