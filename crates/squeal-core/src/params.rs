@@ -150,6 +150,32 @@ impl Params {
     }
 }
 
+/// `value` of the parameter `name` when it is a finite number above 0, else the error
+/// every plugin gives for it ("must be a positive number, got ...").
+pub fn positive(name: &str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::param(
+            name,
+            format!("must be a positive number, got {value}"),
+        ))
+    }
+}
+
+/// `value` of the parameter `name` when `0 < value < 1` (a relative tolerance or cut),
+/// else the error every plugin gives for it ("must be in (0, 1), got ...").
+pub fn fraction(name: &str, value: f64) -> Result<f64> {
+    if value > 0.0 && value < 1.0 {
+        Ok(value)
+    } else {
+        Err(Error::param(
+            name,
+            format!("must be in (0, 1), got {value}"),
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -173,5 +199,19 @@ mod tests {
         let p = Params::new().with_num("tolerance", 1.0);
         let e = p.reject_unknown("x", &["tol"]).unwrap_err().to_string();
         assert!(e.contains("tolerance") && e.contains("tol"), "{e}");
+    }
+
+    #[test]
+    fn range_checks_name_the_parameter_and_the_value() {
+        assert_eq!(positive("cutoff_factor", 1.5).unwrap(), 1.5);
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let e = positive("cutoff_factor", bad).unwrap_err().to_string();
+            assert!(e.contains("cutoff_factor") && e.contains("positive"), "{e}");
+        }
+        assert_eq!(fraction("rank_tol", 1e-10).unwrap(), 1e-10);
+        for bad in [0.0, 1.0, -0.5, f64::NAN] {
+            let e = fraction("rank_tol", bad).unwrap_err().to_string();
+            assert!(e.contains("rank_tol") && e.contains("(0, 1)"), "{e}");
+        }
     }
 }

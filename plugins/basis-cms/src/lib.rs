@@ -35,6 +35,7 @@
 //! [`FreeInterface::correction`]: squeal_core::FreeInterface::correction
 
 use squeal_core::faer::Mat;
+use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{m_orthonormalize, DEFAULT_RANK_TOL};
 use squeal_core::{Basis, BasisRequest, Error, Params, ReductionBasis, Registry, Result};
 use std::time::Instant;
@@ -106,18 +107,8 @@ impl CmsBasis {
                 ),
             ));
         }
-        if !(cutoff_factor.is_finite() && cutoff_factor > 0.0) {
-            return Err(Error::param(
-                "cutoff_factor",
-                format!("must be a positive number, got {cutoff_factor}"),
-            ));
-        }
-        if !(rank_tol > 0.0 && rank_tol < 1.0) {
-            return Err(Error::param(
-                "rank_tol",
-                format!("must be in (0, 1), got {rank_tol}"),
-            ));
-        }
+        positive("cutoff_factor", cutoff_factor)?;
+        fraction("rank_tol", rank_tol)?;
         Ok(Self {
             modes_factor,
             cutoff_factor,

@@ -21,6 +21,7 @@
 //!   orthonormalization.
 
 use squeal_core::linalg::norm2;
+use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
     coupled_real_modes, friction_load_directions, m_orthonormal_extend, m_orthonormalize,
     m_svd_compress, StaticSolver, DEFAULT_RANK_TOL,
@@ -71,17 +72,11 @@ pub struct EnrichedBasis {
 impl EnrichedBasis {
     /// Checks and stores the parameters.
     pub fn new(cutoff_factor: f64, svd_tol: Option<f64>, rank_tol: f64) -> Result<Self> {
-        if !(cutoff_factor.is_finite() && cutoff_factor > 0.0) {
-            return Err(Error::param(
-                "cutoff_factor",
-                format!("must be a positive number, got {cutoff_factor}"),
-            ));
+        positive("cutoff_factor", cutoff_factor)?;
+        if let Some(t) = svd_tol {
+            fraction("svd_tol", t)?;
         }
-        for (name, v) in [("svd_tol", svd_tol.unwrap_or(0.5)), ("rank_tol", rank_tol)] {
-            if !(v > 0.0 && v < 1.0) {
-                return Err(Error::param(name, format!("must be in (0, 1), got {v}")));
-            }
-        }
+        fraction("rank_tol", rank_tol)?;
         Ok(Self {
             cutoff_factor,
             svd_tol,

@@ -18,8 +18,9 @@
 //! - `rank_tol` (default [`DEFAULT_RANK_TOL`]): relative rank cut of the
 //!   `M_c`-orthonormalization.
 
+use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{coupled_real_modes, m_orthonormalize, DEFAULT_RANK_TOL};
-use squeal_core::{Basis, BasisRequest, Error, Params, ReductionBasis, Registry, Result};
+use squeal_core::{Basis, BasisRequest, Params, ReductionBasis, Registry, Result};
 use std::time::Instant;
 
 /// Name under which the basis is registered.
@@ -56,18 +57,8 @@ pub struct ModesBasis {
 impl ModesBasis {
     /// Checks and stores the parameters.
     pub fn new(cutoff_factor: f64, rank_tol: f64) -> Result<Self> {
-        if !(cutoff_factor.is_finite() && cutoff_factor > 0.0) {
-            return Err(Error::param(
-                "cutoff_factor",
-                format!("must be a positive number, got {cutoff_factor}"),
-            ));
-        }
-        if !(rank_tol > 0.0 && rank_tol < 1.0) {
-            return Err(Error::param(
-                "rank_tol",
-                format!("must be in (0, 1), got {rank_tol}"),
-            ));
-        }
+        positive("cutoff_factor", cutoff_factor)?;
+        fraction("rank_tol", rank_tol)?;
         Ok(Self {
             cutoff_factor,
             rank_tol,

@@ -45,6 +45,7 @@
 //! [`EigenSolver::solve_frictional`]: squeal_core::EigenSolver::solve_frictional
 
 use squeal_core::faer::Mat;
+use squeal_core::params::fraction;
 use squeal_core::reduction::{m_orthonormalize, DEFAULT_RANK_TOL};
 use squeal_core::{
     Basis, BasisRequest, EigenParams, Error, ParamValue, Params, ReductionBasis, Registry, Result,
@@ -119,11 +120,8 @@ impl PodBasis {
                 format!("friction coefficients must be finite, got {bad}"),
             ));
         }
-        for (name, v) in [("svd_tol", svd_tol), ("rank_tol", rank_tol)] {
-            if !(v > 0.0 && v < 1.0) {
-                return Err(Error::param(name, format!("must be in (0, 1), got {v}")));
-            }
-        }
+        fraction("svd_tol", svd_tol)?;
+        fraction("rank_tol", rank_tol)?;
         if max_size == Some(0) {
             return Err(Error::param(
                 "max_size",

@@ -32,6 +32,7 @@
 //!   orthonormalization.
 
 use squeal_core::faer::Mat;
+use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
     coupled_real_modes, energy_residuals, expand, m_orthonormal_extend, m_orthonormalize, project,
     StaticSolver, DEFAULT_RANK_TOL,
@@ -108,17 +109,9 @@ impl ResidueBasis {
         shift_hz: f64,
         rank_tol: f64,
     ) -> Result<Self> {
-        if !(cutoff_factor.is_finite() && cutoff_factor > 0.0) {
-            return Err(Error::param(
-                "cutoff_factor",
-                format!("must be a positive number, got {cutoff_factor}"),
-            ));
-        }
-        for (name, v) in [("tol", tol), ("rank_tol", rank_tol)] {
-            if !(v > 0.0 && v < 1.0) {
-                return Err(Error::param(name, format!("must be in (0, 1), got {v}")));
-            }
-        }
+        positive("cutoff_factor", cutoff_factor)?;
+        fraction("tol", tol)?;
+        fraction("rank_tol", rank_tol)?;
         if !(shift_hz.is_finite() && shift_hz >= 0.0) {
             return Err(Error::param(
                 "shift_hz",
