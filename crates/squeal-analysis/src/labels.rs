@@ -10,6 +10,13 @@
 //! with one nodal diameter (a translation of the ring: radial and circumferential
 //! energies equal) are called `c,1`, as in the paper.
 //!
+//! A label the mesh cannot support says so with `?` for the nodal diameters (`a,0,?`,
+//! `r,?`): when the typical ring holds fewer than the `2n + 1` nodes harmonic `n` needs
+//! ([`label_disc`]), and when two distinct modes or doublets of one solve would get the
+//! same label ([`crate::modal::unresolve_repeated_labels`]): one of them at least is
+//! wrong (an aliased harmonic, or an order the label does not show), and nothing tells
+//! which.
+//!
 //! **Pin** (pin + plates): the pin block's best-fit rigid motion `t + w x (x - c)`
 //! names the mode: `shift-x`, `shift-y`, `bounce-z`, `tilt-x`, `tilt-y` (rotation about
 //! that axis) or `twist-z`, whichever moves the pin face most.
@@ -26,16 +33,33 @@ pub struct DiscLabel {
     pub kind: char,
     /// Nodal circles (axial modes only).
     pub circles: Option<usize>,
-    /// Nodal diameters.
+    /// Nodal diameters (the best estimate when not [`resolved`](Self::resolved)).
     pub diameters: usize,
+    /// Whether the mesh resolves `diameters`: the typical ring of nodes holds at least
+    /// `2 diameters + 1` nodes. An unresolved count is written `?`.
+    pub resolved: bool,
 }
 
 impl fmt::Display for DiscLabel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let n = if self.resolved {
+            self.diameters.to_string()
+        } else {
+            "?".into()
+        };
         match self.circles {
-            Some(m) => write!(f, "{},{},{}", self.kind, m, self.diameters),
-            None => write!(f, "{},{}", self.kind, self.diameters),
+            Some(m) => write!(f, "{},{},{n}", self.kind, m),
+            None => write!(f, "{},{n}", self.kind),
         }
+    }
+}
+
+/// `label` with its nodal-diameter count (the last field) replaced by `?`: `a,0,1` ->
+/// `a,0,?`, `c,1` -> `c,?`.
+pub fn unresolved_label(label: &str) -> String {
+    match label.rsplit_once(',') {
+        Some((head, _)) => format!("{head},?"),
+        None => format!("{label},?"),
     }
 }
 
@@ -112,6 +136,9 @@ pub fn label_disc(mesh: &Mesh, weights: &[f64], nodes: &[usize], u: &[f64]) -> D
     sizes.sort_unstable();
     let median = sizes.get(sizes.len() / 2).copied().unwrap_or(0);
     rings.retain(|_, ring| 4 * ring.len() >= median);
+    let mut sizes: Vec<usize> = rings.values().map(Vec::len).collect();
+    sizes.sort_unstable();
+    let typical = sizes.get(sizes.len() / 2).copied().unwrap_or(0);
     let ring_weight =
         |ring: &[usize]| -> f64 { ring.iter().map(|&i| weights[nodes[i]]).sum::<f64>() };
     let nmax = rings.values().map(|v| v.len()).min().unwrap_or(2) / 2;
@@ -138,6 +165,9 @@ pub fn label_disc(mesh: &Mesh, weights: &[f64], nodes: &[usize], u: &[f64]) -> D
         }
     }
     let diameters = best.0;
+    // harmonic n needs 2n + 1 nodes around the ring; at or beyond the Nyquist limit it
+    // cannot be told from its aliases
+    let resolved = 2 * diameters < typical;
     // In-plane motion with one nodal diameter is the ring's translation, with equal
     // radial and circumferential energy; the paper (and common usage) calls it c,1.
     let kind = if kind == 'r' && diameters == 1 {
@@ -174,6 +204,7 @@ pub fn label_disc(mesh: &Mesh, weights: &[f64], nodes: &[usize], u: &[f64]) -> D
         kind,
         circles,
         diameters,
+        resolved,
     }
 }
 
@@ -310,6 +341,35 @@ mod tests {
             &field(&|r, th| [r * (2.0 * th).cos(), 0.2 * r * (2.0 * th).sin(), 0.0]),
         );
         assert_eq!(l.to_string(), "r,2");
+    }
+
+    /// A harmonic the rings cannot resolve is labelled with `?`, not with its alias.
+    #[test]
+    fn unresolvable_diameters_say_so() {
+        // 8 nodes per ring: n = 3 is resolved, n = 4 (the Nyquist limit) is not
+        let m = Mesh::annulus(&linspace(0.05, 0.15, 4), 8, &linspace(-0.02, 0.0, 2));
+        let w = nodal_weights(&m);
+        let nodes: Vec<usize> = (0..m.n_nodes()).collect();
+        let axial = |n: f64| -> Vec<f64> {
+            let mut u = vec![0.0; 3 * m.n_nodes()];
+            for (i, p) in m.nodes.iter().enumerate() {
+                let (r, th) = (p[0].hypot(p[1]), p[1].atan2(p[0]));
+                u[3 * i + 2] = (r - 0.05) * (n * th).cos();
+            }
+            u
+        };
+        assert_eq!(label_disc(&m, &w, &nodes, &axial(3.0)).to_string(), "a,0,3");
+        let l = label_disc(&m, &w, &nodes, &axial(4.0));
+        assert!(!l.resolved, "{l:?}");
+        assert_eq!(l.to_string(), "a,0,?");
+    }
+
+    #[test]
+    fn unresolved_label_forms() {
+        assert_eq!(unresolved_label("a,0,1"), "a,0,?");
+        assert_eq!(unresolved_label("a,1,12"), "a,1,?");
+        assert_eq!(unresolved_label("c,1"), "c,?");
+        assert_eq!(unresolved_label("r,0"), "r,?");
     }
 
     #[test]

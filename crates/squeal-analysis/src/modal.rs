@@ -80,7 +80,29 @@ pub fn label_modes(model: &Model, modes: &RealModes) -> Vec<ModeRecord> {
         })
         .collect();
     pair_doublets(&mut out);
+    unresolve_repeated_labels(&mut out);
     out
+}
+
+/// Writes `?` for the nodal diameters ([`crate::labels::unresolved_label`]) of every disc
+/// label that two distinct modes carry, a doublet (two partners, see [`pair_doublets`])
+/// counting as one: a label names one mode (or doublet), so at least one of them is
+/// wrong, and which one the shapes do not tell. `a,0,1` on five doublets becomes
+/// `a,0,?` on all ten modes. Labels already holding `?` are left as they are.
+pub fn unresolve_repeated_labels(modes: &mut [ModeRecord]) {
+    let mut families: std::collections::BTreeMap<String, usize> = Default::default();
+    for m in modes.iter() {
+        // one count per doublet: its member of lower index
+        let first_of_pair = m.partner.is_none_or(|p| m.index < p);
+        if m.body == "disc" && !m.label.contains('?') && first_of_pair {
+            *families.entry(m.label.clone()).or_default() += 1;
+        }
+    }
+    for m in modes.iter_mut() {
+        if m.body == "disc" && families.get(&m.label).is_some_and(|&k| k > 1) {
+            m.label = crate::labels::unresolved_label(&m.label);
+        }
+    }
 }
 
 /// Pairs disc modes of equal label with `n > 0` whose frequencies differ by less than
@@ -169,4 +191,79 @@ pub fn format_table(rows: &[TableRow]) -> String {
         ));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mode(index: usize, body: &str, freq_hz: f64, label: &str) -> ModeRecord {
+        ModeRecord {
+            body: body.into(),
+            index,
+            freq_hz,
+            label: label.into(),
+            residual: 0.0,
+            partner: None,
+        }
+    }
+
+    /// Five distinct doublets all labelled `a,0,1` (a coarse mesh aliasing their
+    /// harmonics) are all `a,0,?`; a label carried by one doublet or one single mode
+    /// is kept, and pin labels are not disc labels.
+    #[test]
+    fn repeated_labels_become_unresolved() {
+        let mut modes = vec![
+            mode(1, "disc", 1000.0, "a,0,0"),
+            mode(2, "pin", 1100.0, "tilt-x"),
+            mode(3, "pin", 1150.0, "tilt-x"),
+        ];
+        for (k, f) in [1200.0, 2500.0, 4100.0, 6000.0, 8300.0].iter().enumerate() {
+            modes.push(mode(4 + 2 * k, "disc", *f, "a,0,1"));
+            modes.push(mode(5 + 2 * k, "disc", f * 1.001, "a,0,1"));
+        }
+        modes.push(mode(14, "disc", 9000.0, "a,0,2"));
+        modes.push(mode(15, "disc", 9001.0, "a,0,2"));
+        modes.push(mode(16, "disc", 9500.0, "c,0"));
+        pair_doublets(&mut modes);
+        unresolve_repeated_labels(&mut modes);
+        let labels: Vec<&str> = modes.iter().map(|m| m.label.as_str()).collect();
+        assert_eq!(
+            labels,
+            [
+                "a,0,0", "tilt-x", "tilt-x", "a,0,?", "a,0,?", "a,0,?", "a,0,?", "a,0,?", "a,0,?",
+                "a,0,?", "a,0,?", "a,0,?", "a,0,?", "a,0,2", "a,0,2", "c,0"
+            ]
+        );
+        // the doublets stay paired
+        assert_eq!(modes[3].partner, Some(5));
+        // two single modes with one label are two families too
+        let mut singles = vec![
+            mode(1, "disc", 3000.0, "c,1"),
+            mode(2, "disc", 11000.0, "c,1"),
+        ];
+        pair_doublets(&mut singles);
+        unresolve_repeated_labels(&mut singles);
+        assert_eq!(singles[0].label, "c,?");
+        assert_eq!(singles[1].label, "c,?");
+    }
+
+    /// Table 2 finds no frequency for a label squeal left unresolved.
+    #[test]
+    fn unresolved_labels_are_missing_from_table2() {
+        let mut modes = vec![
+            mode(1, "disc", 900.0, "a,0,1"),
+            mode(2, "disc", 901.0, "a,0,1"),
+            mode(3, "disc", 2000.0, "a,0,1"),
+            mode(4, "disc", 2001.0, "a,0,1"),
+        ];
+        pair_doublets(&mut modes);
+        unresolve_repeated_labels(&mut modes);
+        let rows = compare_table2(&modes);
+        let row = rows
+            .iter()
+            .find(|r| r.label == "a,0,1")
+            .expect("Table 2 lists a,0,1");
+        assert_eq!(row.squeal_hz, None);
+    }
 }

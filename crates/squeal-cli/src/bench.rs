@@ -335,15 +335,14 @@ fn print_run(r: &BenchRun) {
 /// A speed ratio with two significant digits: `x64`, `x2.5`, `x0.042`.
 fn times(x: f64) -> String {
     if !x.is_finite() || x <= 0.0 {
-        "-".into()
-    } else if x >= 10.0 {
-        format!("x{x:.0}")
-    } else if x >= 1.0 {
-        format!("x{x:.1}")
-    } else {
-        let digits = (1 - x.log10().floor() as i32).max(1) as usize;
-        format!("x{x:.digits$}")
+        return "-".into();
     }
+    // decimals for two significant digits (none from 10 up)
+    let digits = |v: f64| (1 - v.log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.*}", digits(x));
+    // rounding into the next decade (9.96 -> 10.0) needs one decimal less
+    let v: f64 = s.parse().unwrap_or(x);
+    format!("x{v:.*}", digits(v))
 }
 
 struct Source {
@@ -631,6 +630,38 @@ fn merged_points(
         .collect()
 }
 
+/// Error-vs-size series (named `basis/eigen`) of one basis whose points agree (same
+/// sizes, errors to 1 %: the eigen solvers of one reduced problem) become one series
+/// named `basis/first (~ others)`, so no line hides under another of a different colour.
+fn merged_series(series: Vec<Series>) -> Vec<Series> {
+    let basis = |s: &Series| s.name.split('/').next().unwrap_or("").to_string();
+    let same = |a: &Series, b: &Series| {
+        basis(a) == basis(b)
+            && a.points.len() == b.points.len()
+            && a.points
+                .iter()
+                .zip(&b.points)
+                .all(|(p, q)| p.0 == q.0 && (p.1 - q.1).abs() <= 1e-2 * p.1.abs().max(q.1.abs()))
+    };
+    let mut out: Vec<(Series, Vec<String>)> = Vec::new();
+    for s in series {
+        match out.iter_mut().find(|(g, _)| same(g, &s)) {
+            Some((_, others)) => {
+                others.push(s.name.rsplit('/').next().unwrap_or("").to_string());
+            }
+            None => out.push((s, Vec::new())),
+        }
+    }
+    out.into_iter()
+        .map(|(mut s, others)| {
+            if !others.is_empty() {
+                s.name.push_str(&format!(" (~ {})", others.join(", ")));
+            }
+            s
+        })
+        .collect()
+}
+
 /// Error vs time (total, and per mu with the basis reused; Pareto front marked) and
 /// error vs basis size, per case.
 fn charts(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
@@ -704,6 +735,7 @@ fn charts(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
         for s in &mut series {
             s.points.sort_by(|a, b| a.0.total_cmp(&b.0));
         }
+        let series = merged_series(series);
         if series
             .iter()
             .any(|s| s.points.iter().any(|p| p.0 > 0.0 && p.1 > 0.0))
@@ -936,4 +968,51 @@ pub fn parse_vary(items: &[String]) -> Result<Vec<(String, Vec<f64>)>> {
         out.push((k.trim().to_string(), values));
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{merged_series, times};
+    use squeal_plot::{Series, SeriesStyle};
+
+    #[test]
+    fn speed_ups_keep_two_significant_digits() {
+        assert_eq!(times(64.4), "x64");
+        assert_eq!(times(2.54), "x2.5");
+        assert_eq!(times(0.42), "x0.42");
+        assert_eq!(times(0.042), "x0.042");
+        assert_eq!(times(0.0131), "x0.013");
+        assert_eq!(times(9.96), "x10");
+        assert_eq!(times(0.996), "x1.0");
+        // never x0.0: the printed ratio is within 5 % of the true one, however small
+        for x in [0.04, 0.004, 4e-5, 0.0999, 0.049, 0.951, 1.04] {
+            let t = times(x);
+            let v: f64 = t[1..].parse().unwrap_or_else(|_| panic!("{x}: {t}"));
+            assert!((v / x - 1.0).abs() < 0.05, "{x}: {t}");
+        }
+        assert_eq!(times(0.0), "-");
+        assert_eq!(times(f64::NAN), "-");
+    }
+
+    #[test]
+    fn identical_size_series_merge_by_basis() {
+        let s = |name: &str, pts: &[(f64, f64)]| Series {
+            name: name.into(),
+            points: pts.to_vec(),
+            style: SeriesStyle::LineMarkers,
+            highlight: Vec::new(),
+        };
+        let merged = merged_series(vec![
+            s("cms/arpack", &[(30.0, 1e-6), (40.0, 2e-7)]),
+            s("cms/dense", &[(30.0, 1.001e-6), (40.0, 2e-7)]),
+            s("cms/krylov", &[(30.0, 1e-6), (40.0, 3e-7)]),
+            s("pod/arpack", &[(30.0, 1e-6), (40.0, 2e-7)]),
+        ]);
+        let names: Vec<&str> = merged.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(
+            names,
+            ["cms/arpack (~ dense)", "cms/krylov", "pod/arpack"],
+            "same basis and points merge; a different error or basis does not"
+        );
+    }
 }

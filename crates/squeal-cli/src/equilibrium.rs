@@ -52,11 +52,11 @@ pub fn write_csv(path: &Path, set: &ContactSet, eq: &LoadedEquilibrium) -> Resul
     for i in 0..set.len() {
         writeln!(
             f,
-            "{:.9e},{:.9e},{:.9e},{:.9e},{}",
-            set.xy[i][0],
-            set.xy[i][1],
-            eq.eq.rn[i],
-            eq.eq.mu * eq.eq.rn[i],
+            "{},{},{},{},{}",
+            crate::num::sci(set.xy[i][0], 9),
+            crate::num::sci(set.xy[i][1], 9),
+            crate::num::sci(eq.eq.rn[i], 9),
+            crate::num::sci(eq.eq.mu * eq.eq.rn[i], 9),
             u8::from(eq.eq.active[i])
         )?;
     }
@@ -123,15 +123,15 @@ impl EquilibriumArgs {
         );
         for r in &reports {
             println!(
-                "{:>6.3} {:>10.4} {:>10.4} {:>7} {:>6} {:>10.2e} {:>10.2e} {:>13.4} {:>8.3}",
+                "{:>6.3} {:>10} {:>10} {:>7} {:>6} {:>10.2e} {:>10.2e} {:>13} {:>8.3}",
                 r.mu,
-                r.total_normal_force_n,
-                r.total_tangential_force_n,
+                crate::num::fixed(r.total_normal_force_n, 4),
+                crate::num::fixed(r.total_tangential_force_n, 4),
                 r.active_pairs,
                 r.iterations,
                 r.residual,
                 r.complementarity_residual,
-                r.centroid_m[0] * 1e3,
+                crate::num::fixed(r.centroid_m[0] * 1e3, 4),
                 r.time_s
             );
         }

@@ -6,6 +6,7 @@ mod bench;
 mod calibrate;
 mod equilibrium;
 mod modes;
+mod num;
 mod opts;
 mod scene_cmd;
 mod stability;

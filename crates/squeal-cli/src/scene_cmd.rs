@@ -39,20 +39,75 @@ impl SceneCmd {
     }
 }
 
-/// Prints the embedded scenes with their size, counted by building each.
+/// Measured wall times of `squeal validate` on a 2-core machine, `(free DOFs, seconds)`:
+/// the embedded `pin-on-disc-coarse` and `pin-on-disc` scenes. They calibrate
+/// [`validate_estimate_s`].
+const VALIDATE_RUNS: [(f64, f64); 2] = [(1_779.0, 6.5), (171_963.0, 77.0 * 60.0)];
+
+/// Exponent of the power law `t = t0 (n / n0)^p` through the two [`VALIDATE_RUNS`].
+fn validate_exponent() -> f64 {
+    let [(n0, t0), (n1, t1)] = VALIDATE_RUNS;
+    (t1 / t0).ln() / (n1 / n0).ln()
+}
+
+/// Estimated wall time (s) of `squeal validate` on a scene of `dofs` free DOFs on a
+/// 2-core machine: the power law through the two measured [`VALIDATE_RUNS`]. An
+/// estimate: the stages (disc modes, equilibria, sweeps, full-order reference points)
+/// do not all scale alike, and other machines differ.
+pub fn validate_estimate_s(dofs: usize) -> f64 {
+    let (n0, t0) = VALIDATE_RUNS[0];
+    t0 * (dofs as f64 / n0).powf(validate_exponent())
+}
+
+/// A duration estimate with two significant digits at most: `~7 s`, `~4 min`, `~77 min`,
+/// `~3.3 h`.
+fn approx_duration(s: f64) -> String {
+    let two = |x: f64| {
+        if x >= 10.0 {
+            format!("{x:.0}")
+        } else {
+            let r = format!("{x:.1}");
+            r.strip_suffix(".0").map_or(r.clone(), str::to_string)
+        }
+    };
+    if s < 60.0 {
+        format!("~{} s", two(s.max(1.0)))
+    } else if s < 90.0 * 60.0 {
+        format!("~{} min", two(s / 60.0))
+    } else {
+        format!("~{} h", two(s / 3600.0))
+    }
+}
+
+/// Prints the embedded scenes with their size, counted by building each, and the
+/// estimated run time of `squeal validate` on each.
 fn list(registry: &Registry) -> Result<()> {
-    println!("{:<22} {:>9} {:>7}  what it is", "scene", "DOFs", "pairs");
+    println!(
+        "{:<22} {:>9} {:>7} {:>16}  what it is",
+        "scene", "DOFs", "pairs", "validate (est.)"
+    );
     for name in BUILTIN_SCENES {
         let scene = Scene::builtin(name)?;
         let model = build(&scene, BodyKind::All, registry, name)?;
+        let dofs = model.dofs.n_free();
         println!(
-            "{:<22} {:>9} {:>7}  {}",
+            "{:<22} {:>9} {:>7} {:>16}  {}",
             name,
-            model.dofs.n_free(),
+            dofs,
             model.contact.as_ref().map_or(0, |c| c.len()),
+            approx_duration(validate_estimate_s(dofs)),
             scene.description
         );
     }
+    let [(n0, t0), (n1, t1)] = VALIDATE_RUNS;
+    println!(
+        "\nvalidate (est.): an estimate of the wall time of `squeal validate SCENE` on a \
+         2-core machine, t = {t0} s x (DOFs / {n0})^{:.2}: the power law through two measured \
+         runs ({n0} DOFs in {t0} s, {n1} DOFs in {:.0} min); other machines and scenes that \
+         scale differently will differ.",
+        validate_exponent(),
+        t1 / 60.0
+    );
     println!(
         "\nUse a name as SCENE (`squeal stability pin-on-disc-coarse`), or a scene file; \
          `squeal scene show NAME` prints one to start a file from."
@@ -156,4 +211,33 @@ pub fn info(registry: &Registry, scene: &Scene, file: &str) -> Result<()> {
         None => println!("\ncontact: none (the scene needs a disc and a pin)"),
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{approx_duration, validate_estimate_s, VALIDATE_RUNS};
+
+    #[test]
+    fn validate_estimate_goes_through_the_measured_runs() {
+        for (n, t) in VALIDATE_RUNS {
+            let e = validate_estimate_s(n as usize);
+            assert!(
+                (e / t - 1.0).abs() < 1e-9,
+                "{n} DOFs: {e} s, measured {t} s"
+            );
+        }
+        // growing with the size, faster than linearly but slower than quadratically
+        let (a, b) = (validate_estimate_s(100_000), validate_estimate_s(200_000));
+        assert!(b > 2.0 * a && b < 4.0 * a, "{a} {b}");
+    }
+
+    #[test]
+    fn durations_read_as_estimates() {
+        assert_eq!(approx_duration(6.5), "~6.5 s");
+        assert_eq!(approx_duration(0.2), "~1 s");
+        assert_eq!(approx_duration(240.0), "~4 min");
+        assert_eq!(approx_duration(77.0 * 60.0), "~77 min");
+        assert_eq!(approx_duration(3.3 * 3600.0), "~3.3 h");
+        assert_eq!(approx_duration(12.0 * 3600.0), "~12 h");
+    }
 }

@@ -358,11 +358,11 @@ pub fn print(r: &StabilityReport) {
     );
     for (i, m) in r.modes.iter().enumerate() {
         println!(
-            "{:>4} {:>12.3} {:>14.6e} {:>12.4e} {:>9} {:>10.1e} {:>10} {:>10}",
+            "{:>4} {:>12.3} {:>14} {:>12} {:>9} {:>10.1e} {:>10} {:>10}",
             i + 1,
             m.freq_hz,
-            m.re,
-            m.dvr,
+            crate::num::sci(m.re, 6),
+            crate::num::sci(m.dvr, 4),
             if m.unstable { "YES" } else { "" },
             m.backward_error,
             sci(m.cond),

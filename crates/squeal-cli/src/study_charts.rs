@@ -137,9 +137,17 @@ fn macro_charts(
             }
         }
     }
-    // Figures 14 and 16: how many unstable zones of each class cover each contact pair
+    // Figures 14 and 16: how many unstable zones of each class cover each contact pair.
+    // A mu without a solved case gets no panel (an empty map would read "no unstable
+    // zone"); a partly solved one says how many of its cases the count covers.
+    let planned = def.cases().map(|l| l.cases).unwrap_or_default();
     let mut panels = Vec::new();
     for &mu in mus {
+        let done = recs.iter().filter(|r| r.case.mu == mu).count();
+        if done == 0 {
+            continue;
+        }
+        let total = planned.iter().filter(|c| c.mu == mu).count();
         for &c in &def.solve.classes_hz {
             let zones: Vec<&Record> = recs
                 .iter()
@@ -157,9 +165,9 @@ fn macro_charts(
             }
             panels.push(MapPanel {
                 title: format!(
-                    "mu = {mu}, {}: {} zones",
+                    "mu = {mu}, {}: {}",
                     classes_label(def, c),
-                    zones.len()
+                    zone_count(zones.len(), done, total)
                 ),
                 xy: def.grid.points_m.clone(),
                 values: cover,
@@ -169,6 +177,9 @@ fn macro_charts(
                 arrow_label: "disc".into(),
             });
         }
+    }
+    if panels.is_empty() {
+        return Ok(files);
     }
     files.extend(contact_map(
         &dir.join("zone_map"),
@@ -365,6 +376,17 @@ fn meso_charts(
     Ok(files)
 }
 
+/// The unstable-zone count of a zone-map panel, with the share of the mu's cases it
+/// covers when not all of them were solved (`3 zones (12/40 cases solved)`).
+fn zone_count(zones: usize, done: usize, total: usize) -> String {
+    let noun = if zones == 1 { "zone" } else { "zones" };
+    if done < total {
+        format!("{zones} {noun} ({done}/{total} cases solved)")
+    } else {
+        format!("{zones} {noun}")
+    }
+}
+
 /// A DvR for a caption: 4 decimals, or 2 significant digits below 1e-3 (weak
 /// instabilities would read `0.0000`).
 fn dvr_text(d: f64) -> String {
@@ -377,12 +399,19 @@ fn dvr_text(d: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::dvr_text;
+    use super::{dvr_text, zone_count};
 
     #[test]
     fn weak_dvr_keeps_its_digits() {
         assert_eq!(dvr_text(0.02391), "0.0239");
         assert_eq!(dvr_text(2.69e-5), "2.7e-5");
         assert_eq!(dvr_text(1e-3), "0.0010");
+    }
+
+    #[test]
+    fn zone_count_says_when_cases_are_missing() {
+        assert_eq!(zone_count(0, 40, 40), "0 zones");
+        assert_eq!(zone_count(1, 40, 40), "1 zone");
+        assert_eq!(zone_count(3, 12, 40), "3 zones (12/40 cases solved)");
     }
 }

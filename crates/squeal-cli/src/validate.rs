@@ -340,12 +340,12 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
     for r in &eqs {
         let _ = writeln!(
             md,
-            "| {} | {} / {} | {:.3} | {:.2} | {:.1e} |",
+            "| {} | {} / {} | {} | {} | {:.1e} |",
             r.mu,
             r.active_pairs,
             r.pairs,
-            r.centroid_m[0] * 1e3,
-            r.total_tangential_force_n,
+            crate::num::fixed(r.centroid_m[0] * 1e3, 3),
+            crate::num::fixed(r.total_tangential_force_n, 2),
             r.residual
         );
     }

@@ -8,7 +8,9 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::PALETTE;
-use crate::{auto_linear, fmt_tick, font, render, title_font, Figure, PlotError, CHART_SIZE};
+use crate::{
+    auto_linear, fmt_tick, font, render, tick_in, title_font, Figure, PlotError, CHART_SIZE,
+};
 
 /// Writes a bar chart to `<stem>.svg` and `<stem>.png` (size [`CHART_SIZE`]).
 ///
@@ -97,7 +99,7 @@ impl Figure for BarFig<'_> {
             .x_desc(self.x_label)
             .y_desc(self.y_label)
             .x_label_formatter(&names)
-            .y_label_formatter(&fmt_tick)
+            .y_label_formatter(&tick_in(&self.yr, false))
             .x_label_style(font(label_size))
             .y_label_style(font(14))
             .axis_desc_style(font(16))

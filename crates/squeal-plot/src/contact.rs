@@ -8,7 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::{fmt_tick, font, render, title_font, Figure, PlotError, HIGHLIGHT};
+use crate::{font, render, tick_in, title_font, Figure, PlotError, HIGHLIGHT};
 
 /// One panel of a [`contact_map`]: the contact pairs of one contact set (or one load case).
 ///
@@ -47,6 +47,9 @@ const MAX_COLS: usize = 3;
 const PANEL_W: u32 = 440;
 const PANEL_H: u32 = 420;
 const CBAR_W: u32 = 150;
+/// Of the colour-bar strip: the tick label area and the title strip at its right edge.
+const CBAR_TICKS_W: u32 = 62;
+const CBAR_TITLE_W: u32 = 28;
 const TITLE_H: u32 = 50;
 /// Margins and label areas of a panel chart (pixels), used for the equal-aspect ranges.
 const MARGIN: u32 = 12;
@@ -349,8 +352,15 @@ impl ContactFig<'_> {
         area: &DrawingArea<DB, Shift>,
     ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
         let (xr, yr) = panel_ranges(p, area.dim_in_pixel());
+        // the caption in 18 px, or smaller down to 11 px when it would spill into the
+        // next panel
+        let room = area.dim_in_pixel().0.saturating_sub(2 * MARGIN);
+        let mut size = 18;
+        while size > 11 && area.estimate_text_size(&p.title, &font(size))?.0 > room {
+            size -= 1;
+        }
         let mut chart = ChartBuilder::on(area)
-            .caption(&p.title, font(18))
+            .caption(&p.title, font(size))
             .margin(MARGIN)
             .x_label_area_size(X_LABEL_H)
             .y_label_area_size(Y_LABEL_W)
@@ -362,8 +372,8 @@ impl ContactFig<'_> {
             .y_desc("y (mm)")
             .x_labels(6)
             .y_labels(6)
-            .x_label_formatter(&fmt_tick)
-            .y_label_formatter(&fmt_tick)
+            .x_label_formatter(&tick_in(&xr, false))
+            .y_label_formatter(&tick_in(&yr, false))
             .label_style(font(13))
             .axis_desc_style(font(15))
             .draw()?;
@@ -425,23 +435,35 @@ impl ContactFig<'_> {
         bar: &DrawingArea<DB, Shift>,
         value_label: &str,
     ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-        let (_, h) = bar.dim_in_pixel();
+        let (w, h) = bar.dim_in_pixel();
         let vtop = self.vtop();
+        let top = CAPTION_H + MARGIN;
+        let bottom = X_LABEL_H + MARGIN + 30;
+        // The title is drawn in its own strip at the right edge, not as the axis
+        // description, which plotters places over tick labels wider than its guess.
         let mut cb = ChartBuilder::on(bar)
-            .margin_top(CAPTION_H + MARGIN)
-            .margin_bottom(X_LABEL_H + MARGIN + 30)
+            .margin_top(top)
+            .margin_bottom(bottom)
             .margin_left(10)
-            .margin_right(10)
-            .set_label_area_size(LabelAreaPosition::Right, 55)
+            .margin_right(CBAR_TITLE_W)
+            .set_label_area_size(LabelAreaPosition::Right, CBAR_TICKS_W)
             .build_cartesian_2d(0.0..1.0, 0.0..vtop)?;
+        let ticks = tick_in(&(0.0..vtop), false);
         cb.configure_mesh()
             .disable_mesh()
             .disable_x_axis()
-            .y_desc(value_label)
-            .y_label_formatter(&fmt_tick)
+            .y_labels(6)
+            .y_label_formatter(&ticks)
             .label_style(font(13))
-            .axis_desc_style(font(15))
             .draw()?;
+        let mid = (top as i32 + (h as i32 - bottom as i32)) / 2;
+        bar.draw(&Text::new(
+            value_label.to_string(),
+            (w as i32 - CBAR_TITLE_W as i32 / 2, mid),
+            font(15)
+                .transform(FontTransform::Rotate90)
+                .pos(Pos::new(HPos::Center, VPos::Center)),
+        ))?;
         const STEPS: usize = 64;
         cb.draw_series((0..STEPS).map(|k| {
             let (y0, y1) = (

@@ -53,7 +53,8 @@ pub use contact::{contact_map, contact_map_size, layout_map, MapPanel};
 pub use line::{line_chart, ChartOptions, Series, SeriesStyle};
 pub use pareto::{pareto_chart, pareto_front};
 
-/// Pixel size (width, height) of [`pareto_chart`] and [`bar_chart`] outputs, and the
+/// Pixel size (width, height) of [`bar_chart`] outputs and of the plot area of
+/// [`pareto_chart`] (which adds its legend strip), and the
 /// default [`ChartOptions::size`] of [`line_chart`].
 pub const CHART_SIZE: (u32, u32) = (900, 600);
 
@@ -254,6 +255,63 @@ pub(crate) const PALETTE: [RGBColor; 18] = [
     RGBColor(158, 218, 229),
 ];
 
+/// Colour of series `k`: [`PALETTE`] for the first 18, then hues spaced by the golden
+/// angle (skipping the reds kept for highlights) at alternating lightness, so no two
+/// series share a colour however many there are.
+pub(crate) fn series_colour(k: usize) -> RGBColor {
+    if let Some(c) = PALETTE.get(k) {
+        return *c;
+    }
+    let j = k - PALETTE.len();
+    // hues in [0.1, 0.9] of the circle: away from red at 0
+    let h = 0.1 + 0.8 * (0.13 + j as f64 * 0.618_033_988_75).fract();
+    let l = if j % 2 == 0 { 0.38 } else { 0.58 };
+    let (r, g, b) = hsl_to_rgb(h, 0.65, l);
+    RGBColor(r, g, b)
+}
+
+fn hsl_to_rgb(h: f64, s: f64, l: f64) -> (u8, u8, u8) {
+    let c = (1.0 - (2.0 * l - 1.0).abs()) * s;
+    let hp = h * 6.0;
+    let x = c * (1.0 - (hp % 2.0 - 1.0).abs());
+    let (r, g, b) = match hp as u32 {
+        0 => (c, x, 0.0),
+        1 => (x, c, 0.0),
+        2 => (0.0, c, x),
+        3 => (0.0, x, c),
+        4 => (x, 0.0, c),
+        _ => (c, 0.0, x),
+    };
+    let m = l - c / 2.0;
+    let q = |v: f64| ((v + m) * 255.0).round().clamp(0.0, 255.0) as u8;
+    (q(r), q(g), q(b))
+}
+
+/// Marker outline of series `k`, as pixel offsets around the point, `r` pixels in
+/// radius: circles for the first 9 series (the strong colours of [`PALETTE`]), then
+/// squares, triangles and diamonds, so that series whose colours are light/dark
+/// partners also differ in shape.
+pub(crate) fn series_marker(k: usize, r: i32) -> Vec<(i32, i32)> {
+    let rf = f64::from(r);
+    let poly = |n: usize, phase: f64, scale: f64| -> Vec<(i32, i32)> {
+        (0..n)
+            .map(|i| {
+                let a = phase + std::f64::consts::TAU * i as f64 / n as f64;
+                (
+                    (scale * rf * a.cos()).round() as i32,
+                    (-scale * rf * a.sin()).round() as i32,
+                )
+            })
+            .collect()
+    };
+    match (k / 9) % 4 {
+        0 => poly(20, 0.0, 1.0),
+        1 => poly(4, std::f64::consts::FRAC_PI_4, 1.2),
+        2 => poly(3, std::f64::consts::FRAC_PI_2, 1.3),
+        _ => poly(4, 0.0, 1.3),
+    }
+}
+
 /// Colour of highlighted points (unstable modes, Pareto front).
 pub(crate) const HIGHLIGHT: RGBColor = RGBColor(214, 39, 40);
 
@@ -321,14 +379,30 @@ pub(crate) fn auto_linear(vals: impl Iterator<Item = f64>) -> Option<Range<f64>>
     }
 }
 
-/// Automatic log range of positive `vals` with a margin of 5 % of the decades spanned.
+/// Automatic log range of positive `vals` with a margin of 5 % of the decades spanned,
+/// widened down to a power of ten when it holds none ([`with_decade`]).
 pub(crate) fn auto_log(vals: impl Iterator<Item = f64>) -> Option<Range<f64>> {
     let (lo, hi) = min_max(vals.filter(|v| *v > 0.0))?;
     if hi > lo {
         let f = (hi / lo).powf(0.05).max(1.05);
-        Some(lo / f..hi * f)
+        Some(with_decade(lo / f..hi * f))
     } else {
-        Some(lo / 2.0..hi * 2.0)
+        Some(with_decade(lo / 2.0..hi * 2.0))
+    }
+}
+
+/// A positive log range that holds a power of ten: plotters puts log-axis ticks at the
+/// powers of ten in range (and at their multiples after the first one), so a range
+/// inside one decade would have no tick label at all. Such a range is extended down to
+/// the power of ten below it.
+pub(crate) fn with_decade(r: Range<f64>) -> Range<f64> {
+    let below = 10f64.powf(r.start.log10().floor());
+    let next = below * 10.0;
+    if r.start > below && next > r.end {
+        // 1.0001 keeps the tick inside the range despite round-off of powf
+        below / 1.0001..r.end
+    } else {
+        r
     }
 }
 
@@ -414,6 +488,50 @@ mod tests {
         assert_eq!(t(&6.94e-18), "0");
         assert_eq!(t(&0.01), "0.01");
         assert_eq!(tick_in(&(1e-12..1e-2), true)(&1e-12), "1e-12");
+    }
+
+    #[test]
+    fn series_colours_are_distinct_and_not_red() {
+        let cs: Vec<RGBColor> = (0..60).map(series_colour).collect();
+        for i in 0..cs.len() {
+            for j in 0..i {
+                assert_ne!(cs[i], cs[j], "series {i} and {j}");
+            }
+            assert_ne!(cs[i], HIGHLIGHT, "series {i}");
+            // no pure reds: red well above both green and blue
+            let RGBColor(r, g, b) = cs[i];
+            assert!(
+                !(r > 150 && g < 90 && b < 90),
+                "series {i} is red: {:?}",
+                cs[i]
+            );
+        }
+        assert_eq!(series_colour(3), PALETTE[3]);
+    }
+
+    #[test]
+    fn series_markers_differ_between_light_and_dark_partners() {
+        // series k and k + 9 have light/dark partner colours: their shapes differ
+        for k in 0..9 {
+            assert_ne!(series_marker(k, 6).len(), 0);
+            assert_ne!(series_marker(k, 6), series_marker(k + 9, 6), "series {k}");
+        }
+        assert_ne!(series_marker(18, 6), series_marker(27, 6));
+    }
+
+    #[test]
+    fn log_ranges_hold_a_power_of_ten() {
+        // inside one decade: extended down to the power below
+        let r = with_decade(2.0e-9..7.0e-9);
+        assert!(
+            r.start <= 1e-9 && r.start > 0.9e-9 && r.end == 7.0e-9,
+            "{r:?}"
+        );
+        // already holding a power of ten: unchanged
+        assert_eq!(with_decade(0.5..3.0), 0.5..3.0);
+        assert_eq!(with_decade(1e-3..1e3), 1e-3..1e3);
+        let r = auto_log([3.1e-6, 3.3e-6].into_iter()).unwrap();
+        assert!(r.start < 1e-6 && r.end > 3.3e-6, "{r:?}");
     }
 
     #[test]

@@ -8,8 +8,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::{
-    auto_linear, auto_log, check_range, font, render, tick_in, title_font, with_axes, Figure,
-    PlotError, CHART_SIZE, HIGHLIGHT, PALETTE,
+    auto_linear, auto_log, check_range, font, render, series_colour, series_marker, tick_in,
+    title_font, with_axes, Figure, PlotError, CHART_SIZE, HIGHLIGHT,
 };
 
 /// How a [`Series`] is drawn.
@@ -252,7 +252,7 @@ impl LineFig<'_> {
         let inside = |&(x, y): &(f64, f64)| self.xr.contains(&x) && self.yr.contains(&y);
         let mut legend = false;
         for (k, (s, pts)) in self.series.iter().zip(&self.kept).enumerate() {
-            let color = PALETTE[k % PALETTE.len()];
+            let color = series_colour(k);
             let line = matches!(s.style, SeriesStyle::Line | SeriesStyle::LineMarkers);
             let marks = matches!(s.style, SeriesStyle::Markers | SeriesStyle::LineMarkers);
             let mut labelled = false;
@@ -272,11 +272,16 @@ impl LineFig<'_> {
                 ))?;
                 add_label(ann);
             }
-            let normal = pts
-                .iter()
-                .filter(|(p, h)| marks && !h && inside(p))
-                .map(|(p, _)| Circle::new(*p, 3, color.filled()));
-            let ann = chart.draw_series(normal)?;
+            let normal = pts.iter().filter(|(p, h)| marks && !h && inside(p));
+            // circles for the first nine series, then the other shapes of
+            // `series_marker`, so light/dark partner colours also differ in shape
+            let ann = if k < 9 {
+                chart.draw_series(normal.map(|(p, _)| Circle::new(*p, 3, color.filled())))?
+            } else {
+                chart.draw_series(normal.map(|(p, _)| {
+                    EmptyElement::at(*p) + Polygon::new(series_marker(k, 3), color.filled())
+                }))?
+            };
             add_label(ann);
         }
         // Highlighted points last, on top of every series.

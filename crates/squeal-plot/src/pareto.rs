@@ -6,8 +6,10 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
 use crate::{auto_log, fmt_tick, font, render, title_font, Figure, PlotError, CHART_SIZE};
-use crate::{HIGHLIGHT, PALETTE};
+use crate::{series_colour, series_marker, with_decade, HIGHLIGHT};
 
 /// Indices of the Pareto-optimal points when both coordinates are to be minimised,
 /// sorted by increasing x (then y, then index).
@@ -41,14 +43,16 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
     front
 }
 
-/// Writes a log-log trade-off chart to `<stem>.svg` and `<stem>.png` (size
-/// [`CHART_SIZE`]).
+/// Writes a log-log trade-off chart to `<stem>.svg` and `<stem>.png`.
 ///
 /// `points` are `(label, x, y)` per method, typically `(name, time in s, error)`; both are
-/// minimised. Every point is a circle of its own colour named in the legend (no text on
-/// the plot area, so clustered methods stay readable); the Pareto front
-/// ([`pareto_front`]) is a red line through red rings around its points, in order of x. Points with a non-positive coordinate cannot appear on log axes and are
-/// dropped (also from the front).
+/// minimised. Every point is a marker of its own colour (and, past nine points, its own
+/// shape), named in a legend beside the plot area (no text on the plot area, so
+/// clustered methods stay readable, and no legend box over a point); the Pareto front
+/// ([`pareto_front`]) is a red line through red rings around its points, in order of x.
+/// Points with a non-positive coordinate cannot appear on log axes and are dropped (also
+/// from the front). The image is [`CHART_SIZE`] widened by the legend strip (160 to 520
+/// px, after the longest label) and taller when the legend needs it.
 ///
 /// # Errors
 /// [`PlotError::EmptyData`] if there is no point with both coordinates positive;
@@ -98,12 +102,12 @@ pub fn pareto_chart(
     render(stem, &fig)
 }
 
-/// Log range of `vals` widened by `lo`/`hi` times its number of decades (at least one
-/// decade) below/above, to leave room for the point labels.
+/// Log range of `vals` widened by `lo`/`hi` decades times its number of decades (taken
+/// as at least one) below/above, holding a power of ten for the ticks.
 fn padded(vals: impl Iterator<Item = f64>, lo: f64, hi: f64) -> Range<f64> {
     let r = auto_log(vals).unwrap_or(0.1..10.0);
     let d = (r.end / r.start).log10().max(1.0);
-    r.start / 10f64.powf(lo * d)..r.end * 10f64.powf(hi * d)
+    with_decade(r.start / 10f64.powf(lo * d)..r.end * 10f64.powf(hi * d))
 }
 
 struct ParetoFig<'a> {
@@ -116,16 +120,49 @@ struct ParetoFig<'a> {
     yr: Range<f64>,
 }
 
+/// Legend rows (pixels) and the strip's margins.
+const ROW_H: i32 = 22;
+const LEGEND_PAD: i32 = 12;
+
+impl ParetoFig<'_> {
+    /// Legend entries: the front (when drawn) and every point.
+    fn entries(&self) -> usize {
+        self.points.len() + usize::from(self.front.len() >= 2)
+    }
+
+    /// Width of the legend strip: room for the longest label (DejaVu Sans 14 px is
+    /// under 8 px per character) after a marker, within [160, 520] px.
+    fn legend_w(&self) -> u32 {
+        let chars = self
+            .points
+            .iter()
+            .map(|p| p.0.chars().count())
+            .chain(std::iter::once("Pareto front".len()))
+            .max()
+            .unwrap_or(0);
+        (40 + 8 * chars as u32).clamp(160, 520)
+    }
+}
+
 impl Figure for ParetoFig<'_> {
+    /// [`CHART_SIZE`] for the plot, plus the legend strip on the right; taller when the
+    /// legend needs it.
     fn size(&self) -> (u32, u32) {
-        CHART_SIZE
+        let rows = self.entries() as u32;
+        let h = CHART_SIZE
+            .1
+            .max(rows * ROW_H as u32 + 2 * LEGEND_PAD as u32 + 60);
+        (CHART_SIZE.0 + self.legend_w(), h)
     }
 
     fn draw<DB: DrawingBackend>(
         &self,
         root: &DrawingArea<DB, Shift>,
     ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-        let mut chart = ChartBuilder::on(root)
+        let (w, _) = root.dim_in_pixel();
+        // the legend lives in its own strip, so it never hides a point
+        let (plot, strip) = root.split_horizontally(w - self.legend_w());
+        let mut chart = ChartBuilder::on(&plot)
             .caption(self.title, title_font())
             .margin(15)
             .x_label_area_size(50)
@@ -141,43 +178,64 @@ impl Figure for ParetoFig<'_> {
             .axis_desc_style(font(16))
             .draw()?;
 
-        // every method its own colour and legend entry (no text next to the points,
-        // which piles up where methods cluster); the front is a red line through red
-        // rings around its points
+        // every method its own colour and marker, named in the legend (no text next to
+        // the points, which piles up where methods cluster); the front is a red line
+        // through red rings around its points
         if self.front.len() >= 2 {
-            chart
-                .draw_series(LineSeries::new(
-                    self.front
-                        .iter()
-                        .map(|&i| (self.points[i].1, self.points[i].2)),
-                    HIGHLIGHT.stroke_width(2),
-                ))?
-                .label("Pareto front")
-                .legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 14, y)], HIGHLIGHT.stroke_width(2))
-                });
+            chart.draw_series(LineSeries::new(
+                self.front
+                    .iter()
+                    .map(|&i| (self.points[i].1, self.points[i].2)),
+                HIGHLIGHT.stroke_width(2),
+            ))?;
         }
         chart.draw_series(self.front.iter().map(|&i| {
             Circle::new(
                 (self.points[i].1, self.points[i].2),
-                9,
+                10,
                 HIGHLIGHT.stroke_width(2),
             )
         }))?;
-        for (k, (label, x, y)) in self.points.iter().enumerate() {
-            let color = PALETTE[k % PALETTE.len()];
-            chart
-                .draw_series(std::iter::once(Circle::new((*x, *y), 6, color.filled())))?
-                .label(label.clone())
-                .legend(move |(x, y)| Circle::new((x + 7, y), 6, color.filled()));
+        for (k, (_, x, y)) in self.points.iter().enumerate() {
+            chart.draw_series(std::iter::once(
+                EmptyElement::at((*x, *y))
+                    + Polygon::new(series_marker(k, 6), series_colour(k).filled()),
+            ))?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(font(14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.5))
-            .draw()?;
+
+        // the legend: a framed box at the top of the strip
+        let rows = self.entries() as i32;
+        let (sw, _) = strip.dim_in_pixel();
+        let (x0, y0) = (4, 50);
+        strip.draw(&Rectangle::new(
+            [(x0, y0), (sw as i32 - 6, y0 + rows * ROW_H + LEGEND_PAD)],
+            BLACK.mix(0.5).stroke_width(1),
+        ))?;
+        let text = |s: &str, y: i32| {
+            Text::new(
+                s.to_string(),
+                (x0 + 34, y),
+                font(14).pos(Pos::new(HPos::Left, VPos::Center)),
+            )
+        };
+        let mut y = y0 + LEGEND_PAD / 2 + ROW_H / 2;
+        if self.front.len() >= 2 {
+            strip.draw(&PathElement::new(
+                vec![(x0 + 8, y), (x0 + 26, y)],
+                HIGHLIGHT.stroke_width(2),
+            ))?;
+            strip.draw(&Circle::new((x0 + 17, y), 7, HIGHLIGHT.stroke_width(2)))?;
+            strip.draw(&text("Pareto front", y))?;
+            y += ROW_H;
+        }
+        for (k, (label, _, _)) in self.points.iter().enumerate() {
+            strip.draw(
+                &(EmptyElement::at((x0 + 17, y))
+                    + Polygon::new(series_marker(k, 6), series_colour(k).filled())),
+            )?;
+            strip.draw(&text(label, y))?;
+            y += ROW_H;
+        }
         Ok(())
     }
 }

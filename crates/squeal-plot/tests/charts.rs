@@ -169,6 +169,67 @@ fn contact_map_writes_svg_and_png_with_one_rect_per_pair() {
     assert_eq!(svg.count("polygon"), 2, "one arrow head per panel");
 }
 
+/// `<text>` elements as (content, x, font-size).
+fn text_boxes(svg: &Svg) -> Vec<(String, f64, f64)> {
+    svg.doc()
+        .descendants()
+        .filter(|n| n.has_tag_name("text"))
+        .map(|n| {
+            let t: String = n
+                .descendants()
+                .filter(|c| c.is_text())
+                .filter_map(|c| c.text())
+                .collect();
+            let num = |a: &str| n.attribute(a).and_then(|v| v.parse().ok()).unwrap_or(0.0);
+            (t.trim().to_string(), num("x"), num("font-size"))
+        })
+        .collect()
+}
+
+#[test]
+fn contact_map_texts_do_not_overlap() {
+    let dir = temp_dir("contact-texts");
+    let stem = dir.join("map");
+    let long = "mu = 0.36, ~2100 Hz (+-20 %): 12 zones (30/36 cases solved)";
+    // values up to 12345: wide tick labels on the colour bar
+    let mut wide = grid_panel("short", 4, 3);
+    wide.values = (0..12).map(|i| 12345.0 * i as f64 / 11.0).collect();
+    let panels = [wide, grid_panel(long, 4, 3)];
+    let files = contact_map(&stem, "t", "unstable zones covering the pair", &panels).unwrap();
+    let svg = Svg::load(&files[0]);
+    let boxes = text_boxes(&svg);
+    let find = |s: &str| boxes.iter().find(|b| b.0 == s).cloned().unwrap();
+    // a caption longer than its panel is drawn smaller than a short one, to fit
+    let (short, long) = (find("short"), find(long));
+    assert!(long.2 < short.2, "caption sizes {} vs {}", long.2, short.2);
+    let panel_w = (contact_map_size(2).0 - 150) as f64 / 2.0;
+    assert!(
+        // DejaVu Sans averages about 0.56 em per character of such text
+        0.56 * long.2 * long.0.chars().count() as f64 <= panel_w,
+        "caption of {} px font in a {panel_w} px panel",
+        long.2
+    );
+    // the colour-bar title sits right of every tick label of the bar (numbers of the
+    // strip right of the panels), with room for their width
+    let title = find("unstable zones covering the pair");
+    let strip = 2.0 * panel_w;
+    let ticks: Vec<&(String, f64, f64)> = boxes
+        .iter()
+        .filter(|b| b.1 > strip && b.0.parse::<f64>().is_ok())
+        .collect();
+    assert!(ticks.len() >= 3, "{boxes:?}");
+    for t in ticks {
+        // DejaVu Sans digits are 0.64 em wide
+        let right = t.1 + 0.64 * t.2 * t.0.chars().count() as f64;
+        assert!(
+            right + 0.5 * title.2 <= title.1,
+            "tick {:?} reaches x = {right}, the title is at x = {}",
+            t.0,
+            title.1
+        );
+    }
+}
+
 #[test]
 fn contact_map_grid_beyond_three_panels() {
     let dir = temp_dir("contact-grid");
@@ -473,13 +534,18 @@ fn pareto_chart_marks_front_and_labels() {
     let mut pts = methods();
     pts.push(("free lunch?".into(), 0.0, 1e-3)); // not on a log axis: dropped
     let files = pareto_chart(&stem, "Pareto title", "time (s)", "error (-)", &pts).unwrap();
-    let svg = check_outputs(&stem, &files, CHART_SIZE);
-    // each method its own colour: one point and one legend circle each
+    // the plot area is CHART_SIZE, the legend strip (at least 160 px) is added on the right
+    let svg = Svg::load(&files[0]);
+    let (w, h) = svg.size();
+    assert!(w >= CHART_SIZE.0 + 160 && h == CHART_SIZE.1, "{w} x {h}");
+    let svg = check_outputs(&stem, &files, (w, h));
+    // each method its own colour: one point marker and one legend marker each
     for color in ["#1F77B4", "#FF7F0E", "#2CA02C", "#9467BD", "#8C564B"] {
-        assert_eq!(svg.count_attr("circle", "fill", color), 2, "{color}");
+        assert_eq!(svg.count_attr("polygon", "fill", color), 2, "{color}");
     }
-    // the 3 front points ringed in red, the front line (and its legend swatch) in red
-    assert_eq!(svg.count_attr("circle", "stroke", "#D62728"), 3);
+    // the 3 front points ringed in red (and the legend's ring), the front line (and its
+    // legend swatch) in red
+    assert_eq!(svg.count_attr("circle", "stroke", "#D62728"), 4);
     assert!(
         svg.count_attr("polyline", "stroke", "#D62728") >= 1,
         "front line"
@@ -489,6 +555,68 @@ fn pareto_chart_marks_front_and_labels() {
     }
     assert!(!svg.has_text("free lunch?"));
     assert!(svg.has_text("Pareto title") && svg.has_text("Pareto front"));
+}
+
+/// The x attribute of the `<text>` element reading `s`.
+fn text_x(svg: &Svg, s: &str) -> Option<f64> {
+    svg.doc()
+        .descendants()
+        .filter(|n| n.has_tag_name("text"))
+        .find(|n| {
+            n.descendants()
+                .filter(|c| c.is_text())
+                .filter_map(|c| c.text())
+                .collect::<String>()
+                .trim()
+                == s
+        })
+        .and_then(|n| n.attribute("x"))
+        .and_then(|x| x.parse().ok())
+}
+
+#[test]
+fn pareto_chart_many_clustered_methods_stay_apart() {
+    // 24 methods with nearly equal time and error (a cluster, as the solvers of one
+    // reduced problem give): every one a distinct colour, every name in the legend beside
+    // the plot area, none written over the points
+    let dir = temp_dir("pareto-many");
+    let stem = dir.join("pareto");
+    let pts: Vec<(String, f64, f64)> = (0..24)
+        .map(|k| {
+            (
+                format!("basis{k}/eigen"),
+                0.3 * (1.0 + 0.01 * k as f64),
+                1e-9 * (1.0 + 0.02 * k as f64),
+            )
+        })
+        .collect();
+    let files = pareto_chart(&stem, "many", "time (s)", "error (-)", &pts).unwrap();
+    let svg = Svg::load(&files[0]);
+    let fills: Vec<String> = svg
+        .doc()
+        .descendants()
+        .filter(|n| n.has_tag_name("polygon"))
+        .filter_map(|n| n.attribute("fill").map(str::to_uppercase))
+        .collect();
+    let mut distinct = fills.clone();
+    distinct.sort();
+    distinct.dedup();
+    // 24 points + 24 legend markers, in 24 colours
+    assert_eq!(fills.len(), 48, "{fills:?}");
+    assert_eq!(distinct.len(), 24, "{distinct:?}");
+    for (l, _, _) in &pts {
+        let x = text_x(&svg, l).unwrap_or_else(|| panic!("no legend entry {l}"));
+        assert!(
+            x > f64::from(CHART_SIZE.0),
+            "{l} at x = {x}, inside the plot area"
+        );
+    }
+    // the cluster spans less than a decade in error: the log axis still has tick labels
+    assert!(
+        svg.texts().iter().any(|t| t.contains("e-9")),
+        "no tick label on the error axis: {:?}",
+        svg.texts()
+    );
 }
 
 #[test]
