@@ -6,7 +6,8 @@
 //! values ([`reference`](mod@reference)), method benchmarks ([`bench`](mod@bench)),
 //! sweeps over mu or any parameter of an operator family ([`sweep`], [`family`],
 //! [`mu_sweep`]) and long studies over contact zones ([`study`]), with their
-//! JSON-lines records ([`jsonl`]) and where their time went ([`profile`]).
+//! JSON-lines records ([`jsonl`]) and where their time went ([`profile`]); real modes
+//! shared between the methods of a run ([`modal_cache`]).
 
 pub mod bench;
 pub mod calibrate;
@@ -14,6 +15,7 @@ pub mod family;
 pub mod jsonl;
 pub mod labels;
 pub mod modal;
+pub mod modal_cache;
 pub mod mu_sweep;
 pub mod pipeline;
 pub mod profile;

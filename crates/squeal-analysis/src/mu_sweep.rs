@@ -170,6 +170,7 @@ pub fn run_sweep(
         params,
     )?;
     method.set_condition(s.condition);
+    method.share_modal_cache(prep.modal_cache());
     let mut profile = Profile::new();
     // the synthesis first: its modes, up to a higher cutoff, serve the tracking too
     let t = Instant::now();

@@ -2,6 +2,7 @@
 //! frictional operator -> complex modes. Each stage is timed; the operator is built once
 //! per active set and handed unchanged to any eigen solver or reduction basis.
 
+use crate::modal_cache::{CachedModal, ModalCache};
 use squeal_contact::{
     build_operator, damping_matrix, problem, reference_load, solve_on, ContactError, ContactSet,
     LoadedEquilibrium,
@@ -70,6 +71,8 @@ pub struct Prepared {
     pub build_time_s: f64,
     /// The free model's normal modes and free-interface synthesis, computed once.
     free: Mutex<FreeCache>,
+    /// Real modes of the tied systems solved so far ([`Method::share_modal_cache`]).
+    modal_cache: Arc<ModalCache>,
 }
 
 /// What [`Prepared`] keeps of the free (unconstrained) model between stages: its normal
@@ -115,6 +118,7 @@ impl Prepared {
             g0,
             build_time_s,
             free: Mutex::new(FreeCache::default()),
+            modal_cache: Arc::new(ModalCache::default()),
         })
     }
 
@@ -189,6 +193,12 @@ impl Prepared {
             .unwrap_or_else(|p| p.into_inner())
             .synthesis = Some((cutoff_hz, fi.clone()));
         Ok(fi)
+    }
+
+    /// The real modes of the tied systems solved on this model so far, for
+    /// [`Method::share_modal_cache`].
+    pub fn modal_cache(&self) -> Arc<ModalCache> {
+        self.modal_cache.clone()
     }
 
     /// The sliding equilibrium at `mu` under the scene's load.
@@ -425,7 +435,7 @@ pub struct Method {
     pub eigen_name: String,
     basis: Option<Box<dyn squeal_core::ReductionBasis>>,
     eigen: Box<dyn EigenSolver>,
-    modal: Box<dyn EigenSolver>,
+    modal: Arc<dyn EigenSolver>,
     params: EigenParams,
     cached: Option<squeal_core::reduction::ReducedOperator>,
     free: Option<Arc<FreeInterface>>,
@@ -478,10 +488,12 @@ impl Method {
                 .eigen
                 .create(eigen, &Params::new())
                 .map_err(core("eigen solver"))?,
-            modal: registry
-                .eigen
-                .create(modal, &Params::new())
-                .map_err(core("modal eigen solver"))?,
+            modal: Arc::from(
+                registry
+                    .eigen
+                    .create(modal, &Params::new())
+                    .map_err(core("modal eigen solver"))?,
+            ),
             params,
             cached: None,
             free: None,
@@ -540,6 +552,14 @@ impl Method {
             self.free = Some(prep.free_interface(self.modal.as_ref(), &self.params, cutoff)?);
         }
         Ok(self.free.clone())
+    }
+
+    /// Serves the basis's real-mode solves through `cache` (shared by every method on the
+    /// same model, e.g. [`Prepared::modal_cache`]): a contact set whose modes another
+    /// method or an earlier mu point already computed is not solved again. The basis
+    /// times then leave that solve out.
+    pub fn share_modal_cache(&mut self, cache: Arc<ModalCache>) {
+        self.modal = Arc::new(CachedModal::new(self.modal.clone(), cache));
     }
 
     /// Hands a free-interface synthesis built elsewhere (shared by parallel workers).

@@ -446,6 +446,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
                         params.clone(),
                     )?;
                     method.prepare_free_interface_on(&prep)?;
+                    method.share_modal_cache(prep.modal_cache());
                     method.solve(&op, mu, true)?.0
                 }
             };
