@@ -157,9 +157,11 @@ impl ReductionBasis for ResidueBasis {
         let mut notes = Vec::new();
         let mut iterations = 0;
         let mut history = Vec::new();
+        let mut projected;
         let residual = loop {
             let reduced = project(op, v.as_ref())?;
             let red = request.reduced.solve_frictional(&reduced, mu, &targets)?;
+            projected = reduced;
             if red.is_empty() {
                 notes.push(format!(
                     "{NAME}: no target mode in [{:.1}, {:.1}] Hz",
@@ -206,6 +208,11 @@ impl ReductionBasis for ResidueBasis {
             }
         };
         let mut basis = Basis::new(v);
+        // every exit of the loop leaves `v` as it was last projected (the stagnation exit
+        // kept its columns)
+        if projected.dim() == basis.len() {
+            basis.projected = Some(projected);
+        }
         basis.dropped = dropped;
         basis.iterations = iterations;
         basis.mu = Some(mu);

@@ -26,6 +26,10 @@ pub struct Basis {
     pub residual: Option<f64>,
     /// Anything the user should know (what the columns are, non-convergence, ...).
     pub notes: Vec<String>,
+    /// The operator projected on exactly these columns, when the basis computed it while
+    /// building (an iterative basis projects at every step): the projection stage takes
+    /// it instead of projecting again. `None`: projected after the build.
+    pub projected: Option<FrictionalOperator>,
 }
 
 impl Basis {
@@ -39,6 +43,7 @@ impl Basis {
             mu: None,
             residual: None,
             notes: Vec::new(),
+            projected: None,
         }
     }
 

@@ -16,6 +16,12 @@ pub const DEFAULT_RANK_TOL: f64 = 1e-10;
 /// Columns orthonormalized together (BLAS-3 projections against the kept columns).
 const BLOCK: usize = 32;
 
+/// `M` norm (of a column that started at 1) below which its `M` image is recomputed by a
+/// sparse product rather than carried through the projections: the carried image has an
+/// absolute error of a few roundoffs, so its relative error stays below about 1e-12 above
+/// this.
+const RECOMPUTE_BELOW: f64 = 1e-3;
+
 /// `Y -= A B` for dense matrices.
 fn sub_mul(y: faer::MatMut<'_, f64>, a: MatRef<'_, f64>, b: MatRef<'_, f64>) {
     if a.ncols() > 0 {
@@ -115,8 +121,12 @@ pub fn m_orthonormal_extend(
                 dropped += 1;
                 continue;
             }
+            // `mw = M w` is carried through the projections (`M (w - Q c) = M w - (M Q) c`)
+            // instead of one sparse product per pass; it is recomputed exactly only when
+            // cancellation left `w` short (below RECOMPUTE_BELOW of the unit norm it started
+            // from), where the carried product's relative error would grow
             w.copy_from_slice(blk.col(c).try_as_col_major().unwrap().as_slice());
-            spmv(m, &w, &mut mw);
+            mw.copy_from_slice(mblk.col(c).try_as_col_major().unwrap().as_slice());
             let before = dot(&w, &mw).max(0.0).sqrt();
             if before < rank_tol || before.is_nan() {
                 dropped += 1;
@@ -131,9 +141,13 @@ pub fn m_orthonormal_extend(
                         let coef = tmul(mq, wm);
                         let mut wmut = faer::MatMut::from_column_major_slice_mut(w, n, 1);
                         sub_mul(wmut.as_mut(), qq, coef.as_ref());
+                        let mut mwmut = faer::MatMut::from_column_major_slice_mut(mw, n, 1);
+                        sub_mul(mwmut.as_mut(), mq, coef.as_ref());
                     }
                 }
-                spmv(m, w, mw);
+                if dot(w, mw).max(0.0).sqrt() < RECOMPUTE_BELOW {
+                    spmv(m, w, mw);
+                }
                 dot(w, mw).max(0.0).sqrt()
             };
             let mut nrm = passes(&mut w, &mut mw, k_block, k);

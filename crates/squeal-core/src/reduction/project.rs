@@ -37,12 +37,30 @@ fn project_part(x: SparseRef<'_>, v: MatRef<'_, f64>) -> Result<SparseMat> {
     if rows.is_empty() {
         return dense_to_sparse(Mat::<f64>::zeros(m, m).as_ref());
     }
-    let xv = sparse_times(x, v);
     let red = if rows.len() == n {
-        tmul(v, xv.as_ref())
+        tmul(v, sparse_times(x, v).as_ref())
     } else {
+        // only the rows X touches: (X V)[rows, :], summed over the columns of X in the
+        // same order as `sparse_times`, so the same bits without an n x m product
+        let mut pos = vec![usize::MAX; n];
+        for (p, &i) in rows.iter().enumerate() {
+            pos[i] = p;
+        }
+        let cols: Vec<usize> = (0..x.ncols())
+            .filter(|&j| !x.row_idx_of_col_raw(j).is_empty())
+            .collect();
+        let mut yr = Mat::<f64>::zeros(rows.len(), m);
+        for c in 0..m {
+            let vc = v.col(c);
+            let mut yc = yr.col_mut(c);
+            for &j in &cols {
+                let vj = vc[j];
+                for (&i, &a) in x.row_idx_of_col_raw(j).iter().zip(x.val_of_col(j)) {
+                    yc[pos[i]] += a * vj;
+                }
+            }
+        }
         let vr = Mat::from_fn(rows.len(), m, |i, j| v[(rows[i], j)]);
-        let yr = Mat::from_fn(rows.len(), m, |i, j| xv[(rows[i], j)]);
         tmul(vr.as_ref(), yr.as_ref())
     };
     dense_to_sparse(red.as_ref())

@@ -43,10 +43,14 @@ pub struct ReducedOperator {
 }
 
 impl ReducedOperator {
-    /// Projects `op` on `basis`.
-    pub fn new(op: &FrictionalOperator, basis: Basis) -> Result<Self> {
+    /// Projects `op` on `basis` (or takes the projection the basis carries).
+    pub fn new(op: &FrictionalOperator, mut basis: Basis) -> Result<Self> {
         let start = Instant::now();
-        let reduced = project(op, basis.v.as_ref())?;
+        let m = basis.v.ncols();
+        let reduced = match basis.projected.take() {
+            Some(p) if p.dim() == m => p,
+            _ => project(op, basis.v.as_ref())?,
+        };
         Ok(Self {
             basis,
             reduced,
