@@ -195,6 +195,16 @@ impl Prepared {
         Ok(fi)
     }
 
+    /// Drops the kept free-interface synthesis (its constraint modes are `n x 3 pairs`,
+    /// gigabytes on a large model) once no stage ahead needs it; a later
+    /// [`free_interface`](Self::free_interface) builds it again.
+    pub fn release_free_interface(&self) {
+        self.free
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .synthesis = None;
+    }
+
     /// The real modes of the tied systems solved on this model so far, for
     /// [`Method::share_modal_cache`].
     pub fn modal_cache(&self) -> Arc<ModalCache> {
@@ -265,6 +275,25 @@ pub fn damped_operator(
         set,
         active,
     )?)
+}
+
+/// Whether any of the bases named in `bases` (`none` for full order) works from the
+/// free-interface synthesis for the band top `band_top_hz` (as `cms` does).
+pub fn any_needs_free_interface<'a>(
+    registry: &Registry,
+    bases: impl IntoIterator<Item = &'a str>,
+    band_top_hz: f64,
+) -> Result<bool> {
+    for b in bases.into_iter().filter(|b| *b != "none") {
+        let plugin = registry
+            .bases
+            .create(b, &Params::new())
+            .map_err(core("reduction basis"))?;
+        if plugin.free_interface_cutoff(band_top_hz).is_some() {
+            return Ok(true);
+        }
+    }
+    Ok(false)
 }
 
 /// The free-interface synthesis of `model` for the candidate pairs of `set`

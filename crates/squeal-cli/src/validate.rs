@@ -404,6 +404,12 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
             });
         }
         detail.extend_prefixed(&format!("sweep {basis}: "), &sweep.profile);
+        // the synthesis is the largest thing the model keeps: gone once no sweep ahead
+        // works from it (the references reuse the modes the sweeps kept)
+        let ahead = a.sweeps[i + 1..].iter().map(|(b, _)| b.as_str());
+        if !squeal_analysis::pipeline::any_needs_free_interface(registry, ahead, band[1])? {
+            prep.release_free_interface();
+        }
         kept.push((basis.clone(), sweep.kept));
         summaries.push((basis.clone(), *step, s));
         stage(&format!("sweep {basis} (step {step})"), &mut lap);

@@ -102,6 +102,8 @@ impl ReductionBasis for EnrichedBasis {
         let loads = statics.ncols();
         let ks = StaticSolver::new(op, 0.0)?;
         ks.solve_in_place(statics.as_mut());
+        // the factor is the largest allocation here: freed before the orthonormalization
+        drop(ks);
         let finite = (0..statics.ncols())
             .all(|c| norm2(statics.col(c).try_as_col_major().unwrap().as_slice()).is_finite());
         if !finite {
