@@ -425,17 +425,9 @@ pub fn free_interface_for(
     model: &squeal_scene::Model,
     set: &squeal_contact::ContactSet,
 ) -> Result<Option<squeal_core::FreeInterface>> {
-    let mut cutoff: Option<f64> = None;
-    for b in opts.bases.iter().filter(|b| *b != "none") {
-        let plugin = registry
-            .bases
-            .create(b, &Params::new())
-            .map_err(core(format!("basis `{b}`")))?;
-        if let Some(c) = plugin.free_interface_cutoff(opts.band_hz[1]) {
-            cutoff = Some(cutoff.map_or(c, |x: f64| x.max(c)));
-        }
-    }
-    let Some(cutoff) = cutoff else {
+    let bases = opts.bases.iter().map(String::as_str);
+    let Some(cutoff) = crate::pipeline::free_interface_cutoff(registry, bases, opts.band_hz[1])?
+    else {
         return Ok(None);
     };
     let modal = registry

@@ -18,6 +18,7 @@ use squeal_core::eigen::{RealModes, SymmetricProblem};
 use squeal_core::qep::{ComplexModes, Qep};
 use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Result, SparseRef};
 use std::collections::VecDeque;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// Default budget of a [`ModalCache`]: 384 MiB of mode shapes (13 contact sets of 21
@@ -82,7 +83,7 @@ pub struct ModalCache {
     /// Most bytes of mode shapes kept; older entries are dropped beyond it.
     pub budget_bytes: usize,
     entries: Mutex<VecDeque<Entry>>,
-    hits: Mutex<usize>,
+    hits: AtomicUsize,
 }
 
 impl Default for ModalCache {
@@ -97,13 +98,13 @@ impl ModalCache {
         Self {
             budget_bytes,
             entries: Mutex::new(VecDeque::new()),
-            hits: Mutex::new(0),
+            hits: AtomicUsize::new(0),
         }
     }
 
     /// How many requests were served from the cache.
     pub fn hits(&self) -> usize {
-        *self.hits.lock().unwrap_or_else(|p| p.into_inner())
+        self.hits.load(Ordering::Relaxed)
     }
 
     /// How many solves are kept.
@@ -122,9 +123,8 @@ impl ModalCache {
             .iter()
             .find(|e| &e.key == key)
             .map(|e| e.modes.clone());
-        drop(entries);
         if found.is_some() {
-            *self.hits.lock().unwrap_or_else(|p| p.into_inner()) += 1;
+            self.hits.fetch_add(1, Ordering::Relaxed);
         }
         found
     }
@@ -212,7 +212,6 @@ mod tests {
     use squeal_core::faer::sparse::Triplet;
     use squeal_core::faer::Mat;
     use squeal_core::SparseMat;
-    use std::sync::atomic::{AtomicUsize, Ordering};
 
     /// Diagonal "solver": the first `nev_hint` diagonal ratios, counting its calls.
     struct Counting(Arc<AtomicUsize>);

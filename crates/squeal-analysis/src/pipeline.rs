@@ -277,23 +277,25 @@ pub fn damped_operator(
     )?)
 }
 
-/// Whether any of the bases named in `bases` (`none` for full order) works from the
-/// free-interface synthesis for the band top `band_top_hz` (as `cms` does).
-pub fn any_needs_free_interface<'a>(
+/// The highest free-interface cutoff (Hz) the bases named in `bases` (`none` for full
+/// order, default parameters) ask for at the band top `band_top_hz`; `None` when none of
+/// them works from the free-interface synthesis (only `cms` does).
+pub fn free_interface_cutoff<'a>(
     registry: &Registry,
     bases: impl IntoIterator<Item = &'a str>,
     band_top_hz: f64,
-) -> Result<bool> {
+) -> Result<Option<f64>> {
+    let mut cutoff: Option<f64> = None;
     for b in bases.into_iter().filter(|b| *b != "none") {
         let plugin = registry
             .bases
             .create(b, &Params::new())
-            .map_err(core("reduction basis"))?;
-        if plugin.free_interface_cutoff(band_top_hz).is_some() {
-            return Ok(true);
+            .map_err(core(&format!("basis `{b}`")))?;
+        if let Some(c) = plugin.free_interface_cutoff(band_top_hz) {
+            cutoff = Some(cutoff.map_or(c, |x: f64| x.max(c)));
         }
     }
-    Ok(false)
+    Ok(cutoff)
 }
 
 /// The free-interface synthesis of `model` for the candidate pairs of `set`

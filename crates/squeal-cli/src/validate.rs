@@ -407,7 +407,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
         // the synthesis is the largest thing the model keeps: gone once no sweep ahead
         // works from it (the references reuse the modes the sweeps kept)
         let ahead = a.sweeps[i + 1..].iter().map(|(b, _)| b.as_str());
-        if !squeal_analysis::pipeline::any_needs_free_interface(registry, ahead, band[1])? {
+        if squeal_analysis::pipeline::free_interface_cutoff(registry, ahead, band[1])?.is_none() {
             prep.release_free_interface();
         }
         kept.push((basis.clone(), sweep.kept));

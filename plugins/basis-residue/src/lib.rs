@@ -210,9 +210,7 @@ impl ReductionBasis for ResidueBasis {
         let mut basis = Basis::new(v);
         // every exit of the loop leaves `v` as it was last projected (the stagnation exit
         // kept its columns)
-        if projected.dim() == basis.len() {
-            basis.projected = Some(projected);
-        }
+        basis.projected = Some(projected);
         basis.dropped = dropped;
         basis.iterations = iterations;
         basis.mu = Some(mu);
