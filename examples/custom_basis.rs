@@ -32,7 +32,6 @@ impl ReductionBasis for ModesPlusRandom {
     }
 
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {
-        let start = Instant::now();
         let op = request.op;
         let modes = coupled_real_modes(request, self.cutoff_factor * request.band_hz.1)?;
         let (v, d0) = m_orthonormalize(op.mc.as_ref(), modes.vectors.as_ref(), DEFAULT_RANK_TOL)?;
@@ -58,7 +57,6 @@ impl ReductionBasis for ModesPlusRandom {
             modes.freq_hz.len(),
             self.count
         ));
-        basis.time_s = start.elapsed().as_secs_f64();
         Ok(basis)
     }
 }
@@ -71,7 +69,6 @@ pub fn register(reg: &mut squeal::core::Registry) {
         "modes+random",
         "modes plus smoothed random vectors",
         |p: &Params| {
-            p.reject_unknown("modes+random", &["cutoff_factor", "count"])?;
             let basis: Box<dyn ReductionBasis> = Box::new(ModesPlusRandom {
                 cutoff_factor: p.num_or("cutoff_factor", 1.5)?,
                 count: p.usize_or("count", 40)?,
@@ -98,7 +95,7 @@ fn main() -> std::result::Result<(), Box<dyn std::error::Error>> {
     opts.band_hz = [0.0, 3000.0];
     opts.bases.retain(|b| b != "none");
     opts.eigens = vec!["dense".into()];
-    let (reference, runs) = bench_case(&reg, "example", &op, None, mu, &opts, None, |_| {})?;
+    let (reference, runs) = bench_case(&reg, "example", &op, &Vec::new(), mu, &opts, None, |_| {})?;
     println!(
         "coarse pin-on-disc, mu = {mu}: n_c = {}, reference `{}`: {} modes in 0-{} Hz, {} \
          unstable ({:.2} s)",

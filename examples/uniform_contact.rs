@@ -69,7 +69,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     let (reference, _, _) = full.solve(&op, mu, true)?;
     let mut cms = Method::new(&reg, "cms", &Params::new(), "dense", "arpack", params)?;
-    cms.prepare_free_interface_on(&prep)?;
+    cms.prepare_stage_on(&prep)?;
     let (modes, size, _) = cms.solve(&op, mu, true)?;
     let e = compare(&reference, &modes, band, settings.dvr_tol);
     println!(

@@ -62,19 +62,20 @@ fn build_basis(
     }
     let (arpack, dense) = (solver(reg, "arpack"), solver(reg, "dense"));
     let ep = params(fmax);
-    reg.bases
-        .create(name, &p)
-        .unwrap()
-        .build(&BasisRequest {
+    let basis = reg.bases.create(name, &p).unwrap();
+    squeal::core::build_basis(
+        basis.as_ref(),
+        &BasisRequest {
             op,
             mu,
             band_hz: (0.0, fmax),
             modal: arpack.as_ref(),
             reduced: dense.as_ref(),
             params: &ep,
-            free: None,
-        })
-        .unwrap()
+            stage: None,
+        },
+    )
+    .unwrap()
 }
 
 /// The reduced modes of `op` at `mu` on `basis` (`dense`), expanded, with backward errors

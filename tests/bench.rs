@@ -33,7 +33,7 @@ fn a_basis_registered_at_run_time_appears_in_the_bench() {
     let mu = 0.7;
     let op = coarse_operator(&reg, mu);
     let mut seen = Vec::new();
-    let (reference, runs) = bench_case(&reg, "mu=0.7", &op, None, mu, &opts, None, |r| {
+    let (reference, runs) = bench_case(&reg, "mu=0.7", &op, &Vec::new(), mu, &opts, None, |r| {
         seen.push(format!("{}/{} {}", r.basis, r.eigen, r.basis_opts))
     })
     .unwrap();
@@ -168,7 +168,7 @@ fn bench_json_round_trips_failed_runs() {
     opts.bases = vec!["modes".into(), "failing".into()];
     opts.eigens = vec!["dense".into()];
     opts.vary = Vec::new();
-    let (_, runs) = bench_case(&reg, "mu=0.3", &op, None, mu, &opts, None, |_| {}).unwrap();
+    let (_, runs) = bench_case(&reg, "mu=0.3", &op, &Vec::new(), mu, &opts, None, |_| {}).unwrap();
     let failed = runs
         .iter()
         .find(|r| r.basis == "failing")

@@ -8,6 +8,14 @@ use squeal::contact::ContactSet;
 use squeal::core::qep::ComplexModes;
 use squeal::core::{EigenParams, FrictionalOperator, Params, Registry};
 use squeal::scene::{Damping, Scene, Zone};
+use squeal_basis_cms::FreeInterface;
+
+/// The free-interface synthesis in the model stage of `cms`.
+fn synthesis(stage: &squeal::core::ModelStage) -> &FreeInterface {
+    stage
+        .downcast_ref::<FreeInterface>()
+        .expect("the model stage of cms is its free-interface synthesis")
+}
 
 const FMAX: f64 = 10_000.0;
 
@@ -62,10 +70,11 @@ fn errors(reference: &ComplexModes, got: &ComplexModes) -> (f64, f64, f64) {
 fn cms_matches_full_order_on_equilibrium_sets_and_zones() {
     let (reg, prep) = setup();
     let mut cms = Method::new(&reg, "cms", &Params::new(), "dense", "arpack", params()).unwrap();
-    let fi = cms
-        .prepare_free_interface(&prep.model, &prep.set)
+    let stage = cms
+        .prepare_stage(&prep.model, &prep.set)
         .unwrap()
-        .expect("cms asks for a free-interface synthesis");
+        .expect("cms has a model stage");
+    let fi = synthesis(&stage);
     assert_eq!(fi.pairs(), prep.set.len());
     // free modes up to 3 x the band top (the default modes_factor)
     assert!(fi.cutoff_hz <= 3.0 * FMAX && fi.cutoff_hz > 2.0 * FMAX && fi.modes() > 10);
@@ -121,10 +130,8 @@ fn cms_matches_full_order_on_equilibrium_sets_and_zones() {
 fn the_raw_synthesis_is_close_before_the_ritz_step() {
     let (reg, prep) = setup();
     let mut cms = Method::new(&reg, "cms", &Params::new(), "dense", "arpack", params()).unwrap();
-    let fi = cms
-        .prepare_free_interface(&prep.model, &prep.set)
-        .unwrap()
-        .unwrap();
+    let stage = cms.prepare_stage(&prep.model, &prep.set).unwrap().unwrap();
+    let fi = synthesis(&stage);
     let mu = 0.7;
     let eq = prep.equilibrium(&reg, "lcp", "lagrange", mu).unwrap();
     let op = prep.operator(&eq.eq.active).unwrap();
@@ -182,7 +189,7 @@ fn the_second_order_directions_sharpen_the_ritz_step() {
         let (k, v) = Params::parse_kv(&format!("second_order={second_order}")).unwrap();
         p.0.insert(k, v);
         let mut m = Method::new(&reg, "cms", &p, "dense", "arpack", params()).unwrap();
-        m.prepare_free_interface(&prep.model, &prep.set).unwrap();
+        m.prepare_stage(&prep.model, &prep.set).unwrap();
         let (got, size, _) = m.solve(&op, mu, true).unwrap();
         let (df, ddvr, _) = errors(&reference, &got);
         (df, ddvr, size)
@@ -213,15 +220,17 @@ fn a_prepared_model_computes_its_free_modes_and_synthesis_once() {
     // two methods on the same model share one synthesis ...
     let cms = || Method::new(&reg, "cms", &Params::new(), "dense", "arpack", params()).unwrap();
     let (mut a, mut b) = (cms(), cms());
-    let fa = a.prepare_free_interface_on(&prep).unwrap().unwrap();
-    let fb = b.prepare_free_interface_on(&prep).unwrap().unwrap();
-    assert!(std::sync::Arc::ptr_eq(&fa, &fb));
+    let stage_a = a.prepare_stage_on(&prep).unwrap().unwrap();
+    let stage_b = b.prepare_stage_on(&prep).unwrap().unwrap();
+    assert!(std::sync::Arc::ptr_eq(&stage_a, &stage_b));
+    let fa = synthesis(&stage_a);
     // ... which, built on the condensation's factor of K, synthesizes what one built
     // from scratch does
-    let fresh = cms()
-        .prepare_free_interface(&prep.model, &prep.set)
+    let fresh_stage = cms()
+        .prepare_stage(&prep.model, &prep.set)
         .unwrap()
         .unwrap();
+    let fresh = synthesis(&fresh_stage);
     assert_eq!(fa.modes(), fresh.modes());
     let all: Vec<usize> = (0..fa.pairs()).collect();
     let mut sa: Vec<f64> = fa

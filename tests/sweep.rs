@@ -180,12 +180,7 @@ fn a_sweep_reports_where_its_time_went() {
             .find(|st| st.stage == name)
             .map(|st| st.count)
     };
-    assert_eq!(
-        count("free-interface synthesis"),
-        Some(1),
-        "{:?}",
-        s.profile
-    );
+    assert_eq!(count("model stage of `cms`"), Some(1), "{:?}", s.profile);
     assert_eq!(count("free modes of tracking"), Some(1));
     assert_eq!(count("equilibrium"), Some(mus.len()));
     // `cms` depends on mu: a basis at every point

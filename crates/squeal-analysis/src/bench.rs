@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use squeal_core::contact::BasisRequest;
 use squeal_core::qep::ComplexModes;
 use squeal_core::reduction::ReducedOperator;
-use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Params, Registry};
+use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, ModelStage, Params, Registry};
 use std::time::Instant;
 
 /// A peak-memory probe. The `squeal` binary implements it with a counting global
@@ -416,44 +416,79 @@ fn variants(registry: &Registry, basis: &str, opts: &BenchOptions) -> Vec<(Strin
     out
 }
 
-/// The free-interface synthesis of `model` for the candidate pairs `set`, built when a
-/// basis of `opts` asks for one (`cms`, with its default parameters: the highest cutoff
-/// asked), `None` otherwise. Built once and handed to every [`bench_case`] of the model.
-pub fn free_interface_for(
+/// A model stage ([`squeal_core::ReductionBasis::prepare`]), built once per model and
+/// shared by every case: not part of any run's time, so reported apart.
+#[derive(Clone)]
+pub struct Stage {
+    /// Its [`squeal_core::ReductionBasis::stage_key`].
+    pub key: String,
+    /// The stage.
+    pub stage: ModelStage,
+    /// Wall time to build it (s).
+    pub time_s: f64,
+}
+
+/// The model stages of a bench, one per stage key.
+pub type Stages = Vec<Stage>;
+
+/// The model stages the bases of `opts` and their variants need (`cms`: the
+/// free-interface synthesis) on `model` and the candidate pairs `set`, one per stage key.
+/// Built once and handed to every [`bench_case`] of the model.
+pub fn stages_for(
     registry: &Registry,
     opts: &BenchOptions,
     model: &squeal_scene::Model,
     set: &squeal_contact::ContactSet,
-) -> Result<Option<squeal_core::FreeInterface>> {
-    let bases = opts.bases.iter().map(String::as_str);
-    let Some(cutoff) = crate::pipeline::free_interface_cutoff(registry, bases, opts.band_hz[1])?
-    else {
-        return Ok(None);
-    };
-    let modal = registry
-        .eigen
-        .create(&opts.modal, &Params::new())
-        .map_err(core(format!("eigen solver `{}`", opts.modal)))?;
-    Ok(Some(crate::pipeline::free_interface(
-        model,
-        set,
-        modal.as_ref(),
-        &opts.params(opts.tol),
-        cutoff,
-    )?))
+) -> Result<Stages> {
+    let mut stages: Stages = Vec::new();
+    let params = opts.params(opts.tol);
+    for basis in opts.bases.iter().filter(|b| *b != "none") {
+        for (_, p) in variants(registry, basis, opts) {
+            let plugin = registry
+                .bases
+                .create(basis, &p)
+                .map_err(core(format!("basis `{basis}`")))?;
+            let Some(key) = plugin.stage_key(opts.band_hz[1]) else {
+                continue;
+            };
+            if stages.iter().any(|s| s.key == key) {
+                continue;
+            }
+            let t = Instant::now();
+            let modal = registry
+                .eigen
+                .create(&opts.modal, &Params::new())
+                .map_err(core(format!("eigen solver `{}`", opts.modal)))?;
+            let stage = crate::pipeline::prepare_stage_alone(
+                plugin.as_ref(),
+                model,
+                set,
+                modal.as_ref(),
+                &params,
+            )?;
+            if let Some(stage) = stage {
+                stages.push(Stage {
+                    key,
+                    stage,
+                    time_s: t.elapsed().as_secs_f64(),
+                });
+            }
+        }
+    }
+    Ok(stages)
 }
 
 /// Runs the reference and every combination of `opts` on `op` at `mu`. `on_run` sees
 /// each run as soon as it finishes (to append it to a results file). A failing run is
-/// recorded with its error; only a failing reference stops the case. `free` is the
-/// free-interface synthesis of the model for the bases that ask for one (`cms`); without
-/// it (an operator read from files) such a basis is recorded as failed.
+/// recorded with its error; only a failing reference stops the case. `stages` are the
+/// model stages of the bases that have one ([`stages_for`]; `cms`); without its stage
+/// (an operator read from files) such a basis is recorded as failed.
 #[allow(clippy::too_many_arguments)]
 pub fn bench_case(
     registry: &Registry,
     case: &str,
     op: &FrictionalOperator,
-    free: Option<&squeal_core::FreeInterface>,
+    stages: &Stages,
     mu: f64,
     opts: &BenchOptions,
     memory: Option<&dyn MemoryProbe>,
@@ -583,6 +618,12 @@ pub fn bench_case(
                     .map_err(core(format!("basis `{basis}`")))?;
                 let modal = create(&opts.modal)?;
                 let dense = create("dense")?;
+                let stage = plugin.stage_key(opts.band_hz[1]).and_then(|key| {
+                    stages
+                        .iter()
+                        .find(|s| s.key == key)
+                        .map(|s| s.stage.as_ref())
+                });
                 let req = BasisRequest {
                     op,
                     mu,
@@ -590,10 +631,9 @@ pub fn bench_case(
                     modal: modal.as_ref(),
                     reduced: dense.as_ref(),
                     params: &params,
-                    free,
+                    stage,
                 };
-                let b = plugin
-                    .build(&req)
+                let b = squeal_core::contact::build_basis(plugin.as_ref(), &req)
                     .map_err(core(format!("basis `{basis}` at mu = {mu}")))?;
                 ReducedOperator::new(op, b).map_err(core(format!("projection on `{basis}`")))
             })();

@@ -172,10 +172,14 @@ pub fn run_sweep(
     method.set_condition(s.condition);
     method.share_modal_cache(prep.modal_cache());
     let mut profile = Profile::new();
-    // the synthesis first: its modes, up to a higher cutoff, serve the tracking too
+    // the basis's model stage first: the modes of a synthesis, up to a higher cutoff,
+    // serve the tracking too
     let t = Instant::now();
-    if method.prepare_free_interface_on(prep)?.is_some() {
-        profile.add("free-interface synthesis", t.elapsed().as_secs_f64());
+    if method.prepare_stage_on(prep)?.is_some() {
+        profile.add(
+            &format!("model stage of `{}`", method.basis_name),
+            t.elapsed().as_secs_f64(),
+        );
     }
     let t = Instant::now();
     let free = prep.free_interface_modes(registry, "arpack", 1.5 * s.band_hz[1])?;

@@ -7,11 +7,12 @@ use squeal_contact::{
     build_operator, damping_matrix, problem, reference_load, solve_on, ContactError, ContactSet,
     LoadedEquilibrium,
 };
-use squeal_core::contact::Condensation;
+use squeal_core::contact::{Condensation, NormalModes};
+use squeal_core::linalg::Cholesky;
 use squeal_core::qep::ComplexModes;
 use squeal_core::{
-    EigenParams, EigenSolver, FreeInterface, FrictionalOperator, PairDofs, Params, RealModes,
-    Registry, SymmetricProblem,
+    EigenParams, EigenSolver, FreeModel, FrictionalOperator, ModelStage, PairDofs, Params,
+    RealModes, ReductionBasis, Registry, SymmetricProblem,
 };
 use squeal_scene::{build, BodyKind, Damping, Model, Scene, SceneError};
 use std::sync::{Arc, Mutex};
@@ -69,21 +70,22 @@ pub struct Prepared {
     pub g0: Vec<f64>,
     /// Build time (s).
     pub build_time_s: f64,
-    /// The free model's normal modes and free-interface synthesis, computed once.
+    /// The free model's normal modes and the bases' model stages, computed once.
     free: Mutex<FreeCache>,
     /// Real modes of the tied systems solved so far ([`Method::share_modal_cache`]).
     modal_cache: Arc<ModalCache>,
 }
 
 /// What [`Prepared`] keeps of the free (unconstrained) model between stages: its normal
-/// modes up to the highest frequency asked so far, and its free-interface synthesis on the
-/// candidate pairs (which takes the condensation's factor of `K`).
+/// modes up to the highest frequency asked so far, and the model stages of the bases
+/// ([`ReductionBasis::prepare`], e.g. the free-interface synthesis of `cms`, which takes
+/// the condensation's factor of `K`), by stage key.
 #[derive(Default)]
 struct FreeCache {
     /// Modes complete up to `.0` Hz at tolerance `.1`.
     modes: Option<(f64, f64, Arc<RealModes>)>,
-    /// Synthesis from the modes up to `.0` Hz.
-    synthesis: Option<(f64, Arc<FreeInterface>)>,
+    /// Model stages by [`ReductionBasis::stage_key`].
+    stages: Vec<(String, ModelStage)>,
 }
 
 /// The modes of `modes` up to `fmax_hz` (they are sorted by frequency).
@@ -132,77 +134,92 @@ impl Prepared {
         fmax_hz: f64,
         tol: f64,
     ) -> Result<RealModes> {
+        self.normal_modes_core(solver, fmax_hz, tol)
+            .map_err(core("normal modes of the free model"))
+    }
+
+    /// [`normal_modes`](Self::normal_modes) with the solver's own error.
+    fn normal_modes_core(
+        &self,
+        solver: &dyn EigenSolver,
+        fmax_hz: f64,
+        tol: f64,
+    ) -> squeal_core::Result<RealModes> {
         let mut cache = self.free.lock().unwrap_or_else(|p| p.into_inner());
         if let Some((top, t, modes)) = &cache.modes {
             if *top >= fmax_hz && *t <= tol {
                 return Ok(modes_below(modes, fmax_hz));
             }
         }
-        let modes = solver
-            .solve_symmetric(
-                &SymmetricProblem {
-                    k: self.model.k.as_ref(),
-                    m: self.model.m.as_ref(),
-                },
-                &EigenParams {
-                    fmin_hz: 0.0,
-                    fmax_hz,
-                    tol,
-                    nev_hint: None,
-                    ..EigenParams::default()
-                },
-            )
-            .map_err(core("normal modes of the free model"))?;
+        let modes = solver.solve_symmetric(
+            &SymmetricProblem {
+                k: self.model.k.as_ref(),
+                m: self.model.m.as_ref(),
+            },
+            &EigenParams {
+                fmin_hz: 0.0,
+                fmax_hz,
+                tol,
+                nev_hint: None,
+                ..EigenParams::default()
+            },
+        )?;
         cache.modes = Some((fmax_hz, tol, Arc::new(modes.clone())));
         Ok(modes)
     }
 
-    /// The free-interface synthesis of the model on its candidate pairs
-    /// ([`squeal_core::synthesis`]) from the normal modes up to `cutoff_hz` (by `modal` at
-    /// the tolerance of `params`), on the condensation's factor of `K`. Built once per
-    /// cutoff and shared.
-    pub fn free_interface(
+    /// The model stage of `basis` ([`ReductionBasis::prepare`]) for a band whose top is
+    /// `params.fmax_hz`: built once per stage key on the free model, its candidate pairs,
+    /// the condensation's factor of `K` and the normal modes kept here (by `modal` at the
+    /// tolerance of `params`), then shared by every method and stage on the scene. `None`
+    /// when the basis has no model stage.
+    pub fn model_stage(
         &self,
+        basis: &dyn ReductionBasis,
         modal: &dyn EigenSolver,
         params: &EigenParams,
-        cutoff_hz: f64,
-    ) -> Result<Arc<FreeInterface>> {
-        if let Some((c, fi)) = &self
-            .free
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .synthesis
-        {
-            if *c == cutoff_hz {
-                return Ok(fi.clone());
+    ) -> Result<Option<ModelStage>> {
+        let Some(key) = basis.stage_key(params.fmax_hz) else {
+            return Ok(None);
+        };
+        let kept = |cache: &FreeCache| {
+            cache
+                .stages
+                .iter()
+                .find(|(k, _)| *k == key)
+                .map(|(_, s)| s.clone())
+        };
+        if let Some(stage) = kept(&self.free.lock().unwrap_or_else(|p| p.into_inner())) {
+            return Ok(Some(stage));
+        }
+        let modes = |fmax_hz: f64| self.normal_modes_core(modal, fmax_hz, params.tol);
+        let stage = prepare_stage(
+            basis,
+            &self.model,
+            &self.set,
+            Some(self.condensation.factor().clone()),
+            &modes,
+            modal,
+            params,
+        )?;
+        if let Some(stage) = &stage {
+            let mut cache = self.free.lock().unwrap_or_else(|p| p.into_inner());
+            if kept(&cache).is_none() {
+                cache.stages.push((key, stage.clone()));
             }
         }
-        let modes = self.normal_modes(modal, cutoff_hz, params.tol)?;
-        let fi = Arc::new(
-            FreeInterface::with_factor(
-                self.model.k.as_ref(),
-                self.model.m.as_ref(),
-                &pair_dofs(&self.set),
-                &modes,
-                self.condensation.factor().clone(),
-            )
-            .map_err(core("free-interface synthesis"))?,
-        );
-        self.free
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .synthesis = Some((cutoff_hz, fi.clone()));
-        Ok(fi)
+        Ok(stage)
     }
 
-    /// Drops the kept free-interface synthesis (its constraint modes are `n x 3 pairs`,
-    /// gigabytes on a large model) once no stage ahead needs it; a later
-    /// [`free_interface`](Self::free_interface) builds it again.
-    pub fn release_free_interface(&self) {
+    /// Drops the kept model stages whose keys are not in `keep` (a free-interface
+    /// synthesis holds `n x 3 pairs` values, gigabytes on a large model) once no stage
+    /// ahead needs them; a later [`model_stage`](Self::model_stage) builds them again.
+    pub fn release_stages_except(&self, keep: &[String]) {
         self.free
             .lock()
             .unwrap_or_else(|p| p.into_inner())
-            .synthesis = None;
+            .stages
+            .retain(|(k, _)| keep.contains(k));
     }
 
     /// The real modes of the tied systems solved on this model so far, for
@@ -277,53 +294,86 @@ pub fn damped_operator(
     )?)
 }
 
-/// The highest free-interface cutoff (Hz) the bases named in `bases` (`none` for full
-/// order, default parameters) ask for at the band top `band_top_hz`; `None` when none of
-/// them works from the free-interface synthesis (only `cms` does).
-pub fn free_interface_cutoff<'a>(
+/// The model-stage keys ([`ReductionBasis::stage_key`]) of the bases named in `bases`
+/// (`none` for full order, default parameters) at the band top `band_top_hz`, without
+/// repeats: what a run that goes on with those bases still needs of the free model.
+pub fn stage_keys<'a>(
     registry: &Registry,
     bases: impl IntoIterator<Item = &'a str>,
     band_top_hz: f64,
-) -> Result<Option<f64>> {
-    let mut cutoff: Option<f64> = None;
+) -> Result<Vec<String>> {
+    let mut keys = Vec::new();
     for b in bases.into_iter().filter(|b| *b != "none") {
         let plugin = registry
             .bases
             .create(b, &Params::new())
             .map_err(core(&format!("basis `{b}`")))?;
-        if let Some(c) = plugin.free_interface_cutoff(band_top_hz) {
-            cutoff = Some(cutoff.map_or(c, |x: f64| x.max(c)));
+        if let Some(k) = plugin.stage_key(band_top_hz) {
+            if !keys.contains(&k) {
+                keys.push(k);
+            }
         }
     }
-    Ok(cutoff)
+    Ok(keys)
 }
 
-/// The free-interface synthesis of `model` for the candidate pairs of `set`
-/// ([`squeal_core::synthesis`]): the normal modes of the unconstrained model up to
-/// `cutoff_hz` by `modal` (tolerances from `params`) and the static contact responses.
-pub fn free_interface(
+/// The model stage of `basis` ([`ReductionBasis::prepare`]) on `model` and the candidate
+/// pairs of `set`, with `k_factor` (a Cholesky factor of the model's `K`, when the caller
+/// has one) and `normal_modes` (the free model's modes up to a frequency); `modal` and
+/// `params` as the stage's solver and tolerances, `params.fmax_hz` the band top. `None`
+/// when the basis has no model stage.
+pub fn prepare_stage(
+    basis: &dyn ReductionBasis,
+    model: &Model,
+    set: &ContactSet,
+    k_factor: Option<Arc<Cholesky>>,
+    normal_modes: &NormalModes<'_>,
+    modal: &dyn EigenSolver,
+    params: &EigenParams,
+) -> Result<Option<ModelStage>> {
+    if basis.stage_key(params.fmax_hz).is_none() {
+        return Ok(None);
+    }
+    let pairs = pair_dofs(set);
+    let free = FreeModel {
+        k: model.k.as_ref(),
+        m: model.m.as_ref(),
+        pairs: &pairs,
+        k_factor,
+        normal_modes,
+        modal,
+        band_hz: (params.fmin_hz, params.fmax_hz),
+        params,
+    };
+    basis
+        .prepare(&free)
+        .map_err(core(&format!("model stage of basis `{}`", basis.name())))
+}
+
+/// [`prepare_stage`] without a factor of `K` or kept modes: the normal modes of the free
+/// model are solved by `modal` at the tolerances of `params`.
+pub fn prepare_stage_alone(
+    basis: &dyn ReductionBasis,
     model: &Model,
     set: &ContactSet,
     modal: &dyn EigenSolver,
     params: &EigenParams,
-    cutoff_hz: f64,
-) -> Result<FreeInterface> {
-    let modes = modal
-        .solve_symmetric(
+) -> Result<Option<ModelStage>> {
+    let modes = |fmax_hz: f64| {
+        modal.solve_symmetric(
             &SymmetricProblem {
                 k: model.k.as_ref(),
                 m: model.m.as_ref(),
             },
             &EigenParams {
                 fmin_hz: 0.0,
-                fmax_hz: cutoff_hz,
+                fmax_hz,
                 nev_hint: None,
                 ..params.clone()
             },
         )
-        .map_err(core("free-interface modes of the synthesis"))?;
-    FreeInterface::new(model.k.as_ref(), model.m.as_ref(), &pair_dofs(set), &modes)
-        .map_err(core("free-interface synthesis"))
+    };
+    prepare_stage(basis, model, set, None, &modes, modal, params)
 }
 
 /// The DOFs of the candidate pairs of `set`, in the synthesis's terms.
@@ -469,7 +519,7 @@ pub struct Method {
     modal: Arc<dyn EigenSolver>,
     params: EigenParams,
     cached: Option<squeal_core::reduction::ReducedOperator>,
-    free: Option<Arc<FreeInterface>>,
+    stage: Option<ModelStage>,
     condition: bool,
     last: StepTimes,
 }
@@ -527,7 +577,7 @@ impl Method {
             ),
             params,
             cached: None,
-            free: None,
+            stage: None,
             condition: false,
             last: StepTimes::default(),
         })
@@ -543,46 +593,45 @@ impl Method {
         self.condition = always;
     }
 
-    /// The free-interface cutoff (Hz) the basis asks for, `None` when it needs no
-    /// free-interface synthesis (full order, or any basis but `cms`).
-    pub fn free_interface_cutoff(&self) -> Option<f64> {
+    /// The key of the model stage the basis needs ([`ReductionBasis::stage_key`]), `None`
+    /// for full order and for a basis without one (every basis but `cms`).
+    pub fn stage_key(&self) -> Option<String> {
         self.basis
             .as_ref()
-            .and_then(|b| b.free_interface_cutoff(self.params.fmax_hz))
+            .and_then(|b| b.stage_key(self.params.fmax_hz))
     }
 
-    /// Builds the free-interface synthesis the basis needs (once: a later call keeps the
-    /// one it has) for `model` and the candidate pairs `set`, every contact set solved
-    /// later being a subset of them. Returns it, shared (`None` when the basis needs none).
-    pub fn prepare_free_interface(
-        &mut self,
-        model: &Model,
-        set: &ContactSet,
-    ) -> Result<Option<Arc<FreeInterface>>> {
-        let Some(cutoff) = self.free_interface_cutoff() else {
+    /// Builds the model stage the basis needs (once: a later call keeps the one it has)
+    /// for `model` and the candidate pairs `set`, every contact set solved later being a
+    /// subset of them ([`prepare_stage_alone`]). Returns it, shared (`None` when the
+    /// basis has none).
+    pub fn prepare_stage(&mut self, model: &Model, set: &ContactSet) -> Result<Option<ModelStage>> {
+        let Some(basis) = &self.basis else {
             return Ok(None);
         };
-        if self.free.is_none() {
-            let fi = free_interface(model, set, self.modal.as_ref(), &self.params, cutoff)?;
-            self.free = Some(Arc::new(fi));
+        if self.stage.is_none() {
+            self.stage = prepare_stage_alone(
+                basis.as_ref(),
+                model,
+                set,
+                self.modal.as_ref(),
+                &self.params,
+            )?;
         }
-        Ok(self.free.clone())
+        Ok(self.stage.clone())
     }
 
-    /// [`prepare_free_interface`](Self::prepare_free_interface) from the synthesis
-    /// `prep` keeps (built there once, on the condensation's factor of `K`, and shared
-    /// with every method and stage on the same scene).
-    pub fn prepare_free_interface_on(
-        &mut self,
-        prep: &Prepared,
-    ) -> Result<Option<Arc<FreeInterface>>> {
-        let Some(cutoff) = self.free_interface_cutoff() else {
+    /// [`prepare_stage`](Self::prepare_stage) from the stages `prep` keeps (built there
+    /// once, on the condensation's factor of `K`, and shared with every method and stage
+    /// on the same scene).
+    pub fn prepare_stage_on(&mut self, prep: &Prepared) -> Result<Option<ModelStage>> {
+        let Some(basis) = &self.basis else {
             return Ok(None);
         };
-        if self.free.is_none() {
-            self.free = Some(prep.free_interface(self.modal.as_ref(), &self.params, cutoff)?);
+        if self.stage.is_none() {
+            self.stage = prep.model_stage(basis.as_ref(), self.modal.as_ref(), &self.params)?;
         }
-        Ok(self.free.clone())
+        Ok(self.stage.clone())
     }
 
     /// Serves the basis's real-mode solves through `cache` (shared by every method on the
@@ -593,9 +642,9 @@ impl Method {
         self.modal = Arc::new(CachedModal::new(self.modal.clone(), cache));
     }
 
-    /// Hands a free-interface synthesis built elsewhere (shared by parallel workers).
-    pub fn set_free_interface(&mut self, free: Option<Arc<FreeInterface>>) {
-        self.free = free;
+    /// Hands a model stage built elsewhere (shared by parallel workers).
+    pub fn set_stage(&mut self, stage: Option<ModelStage>) {
+        self.stage = stage;
     }
 
     /// Where the time of the last [`solve`](Self::solve) went.
@@ -640,10 +689,9 @@ impl Method {
                 modal: self.modal.as_ref(),
                 reduced: self.eigen.as_ref(),
                 params: &self.params,
-                free: self.free.as_deref(),
+                stage: self.stage.as_deref(),
             };
-            let b = basis
-                .build(&req)
+            let b = squeal_core::contact::build_basis(basis.as_ref(), &req)
                 .map_err(core(&format!("basis `{}` at mu = {mu}", self.basis_name)))?;
             self.cached = Some(
                 squeal_core::reduction::ReducedOperator::new(op, b)

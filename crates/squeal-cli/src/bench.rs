@@ -200,6 +200,9 @@ struct Summary<'a> {
     references: Vec<ReferenceSolve>,
     speed_ratios: Vec<SpeedRatio>,
     cases: Vec<CaseInfo>,
+    /// Model stages built once before the cases (e.g. the free-interface synthesis of
+    /// `cms`): `(key, time_s)`, not part of any run's time.
+    model_stages: Vec<(String, f64)>,
     time_s: f64,
     charts: Vec<String>,
 }
@@ -470,19 +473,25 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
             .map(|&mu| (format!("mu={mu}"), format!("mu = {mu}"), mu, None, None))
             .collect()
     };
-    // the free-interface synthesis of the scene's model, for a basis that asks for one
-    // (every pair of the face: a stress zone is a subset)
-    let free = match &src.prep {
+    // the model stages of the bases that have one (`cms`: the free-interface synthesis),
+    // on every pair of the face: a stress zone is a subset
+    let stages = match &src.prep {
         Some(prep) => {
             let all = squeal_contact::ContactSet::new(
                 &prep.model,
                 &Zone::Uniform,
                 prep.scene.study.rotation,
             )?;
-            squeal_analysis::bench::free_interface_for(registry, &base_opts, &prep.model, &all)?
+            squeal_analysis::bench::stages_for(registry, &base_opts, &prep.model, &all)?
         }
-        None => None,
+        None => Vec::new(),
     };
+    for s in &stages {
+        println!(
+            "model stage `{}`: built once in {:.1} s, shared by every case (not in the run times)",
+            s.key, s.time_s
+        );
+    }
     let mut all_runs = Vec::new();
     let mut refs = Vec::new();
     let mut infos = Vec::new();
@@ -503,13 +512,12 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
             opts.defaults = false;
         }
         let mut append_err = None;
-        let (reference, runs) =
-            bench_case(registry, case, &op, free.as_ref(), *mu, &opts, probe, |r| {
-                print_run(r);
-                if let Err(e) = append(&partial, r) {
-                    append_err.get_or_insert(e);
-                }
-            })?;
+        let (reference, runs) = bench_case(registry, case, &op, &stages, *mu, &opts, probe, |r| {
+            print_run(r);
+            if let Err(e) = append(&partial, r) {
+                append_err.get_or_insert(e);
+            }
+        })?;
         if let Some(e) = append_err {
             return Err(e);
         }
@@ -556,6 +564,7 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
         references: refs,
         speed_ratios: ratios.clone(),
         cases: infos,
+        model_stages: stages.iter().map(|s| (s.key.clone(), s.time_s)).collect(),
         time_s: start.elapsed().as_secs_f64(),
         charts: charts.iter().map(|p| p.display().to_string()).collect(),
     };

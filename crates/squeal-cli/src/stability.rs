@@ -280,7 +280,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
     )?;
     method.set_condition(a.condition);
     if let Some(prep) = &src.prep {
-        method.prepare_free_interface_on(prep)?;
+        method.prepare_stage_on(prep)?;
     }
     let (modes, basis_size, basis_time_s) = method.solve(&src.op, src.mu, true)?;
     let out: Vec<ModeOut> = (0..modes.len())

@@ -404,12 +404,12 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
             });
         }
         detail.extend_prefixed(&format!("sweep {basis}: "), &sweep.profile);
-        // the synthesis is the largest thing the model keeps: gone once no sweep ahead
-        // works from it (the references reuse the modes the sweeps kept)
+        // a model stage (the synthesis of `cms`) is the largest thing the model keeps:
+        // gone once no sweep ahead works from it (the references reuse the kept modes)
         let ahead = a.sweeps[i + 1..].iter().map(|(b, _)| b.as_str());
-        if squeal_analysis::pipeline::free_interface_cutoff(registry, ahead, band[1])?.is_none() {
-            prep.release_free_interface();
-        }
+        prep.release_stages_except(&squeal_analysis::pipeline::stage_keys(
+            registry, ahead, band[1],
+        )?);
         kept.push((basis.clone(), sweep.kept));
         summaries.push((basis.clone(), *step, s));
         stage(&format!("sweep {basis} (step {step})"), &mut lap);
@@ -451,7 +451,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<()> {
                         "arpack",
                         params.clone(),
                     )?;
-                    method.prepare_free_interface_on(&prep)?;
+                    method.prepare_stage_on(&prep)?;
                     method.share_modal_cache(prep.modal_cache());
                     method.solve(&op, mu, true)?.0
                 }

@@ -10,8 +10,7 @@
 //! - the [`Registry`] that maps plugin names to constructors;
 //! - shared numerical machinery that every backend uses the same way ([`linalg`], [`qep`],
 //!   [`lowrank`] for the Woodbury path of undamped frictional operators, and [`reduction`]
-//!   for the reduction bases, [`synthesis`] for the free-interface modal synthesis shared by
-//!   every contact set of a study);
+//!   for the reduction bases);
 //! - [`interop`]: sparse matrices and whole operators to and from `nalgebra-sparse` and
 //!   `sprs` (features of the same names).
 //!
@@ -30,10 +29,10 @@ pub mod params;
 pub mod qep;
 pub mod reduction;
 pub mod registry;
-pub mod synthesis;
 
 pub use contact::{
-    Basis, BasisRequest, ContactLaw, EquilibriumSolver, FrictionalOperator, ReductionBasis,
+    build_basis, Basis, BasisRequest, ContactLaw, EquilibriumSolver, FreeModel, FrictionalOperator,
+    ModelStage, PairDofs, ReductionBasis,
 };
 pub use eigen::{
     solve_symmetric_band, EigenParams, EigenSolver, KernelOutput, RealModes, SolveInfo, StopReason,
@@ -49,7 +48,6 @@ pub use qep::{
 };
 pub use reduction::{solve_reduced, ReducedOperator, ReducedSolve};
 pub use registry::Registry;
-pub use synthesis::{FreeInterface, PairDofs, Synthesized};
 
 pub use faer;
 /// Complex double, the scalar of the frictional (non-symmetric) problems.

@@ -1,10 +1,14 @@
 //! Name/value parameters from which plugins are constructed.
 //!
 //! Scene files and the command line (`--basis-opt k=v`) both end up as [`Params`]; a plugin
-//! reads them through the typed getters, which produce errors naming the key.
+//! reads them through the typed getters, which produce errors naming the key. The getters
+//! also note every key asked for, present or not: the [`Registry`](crate::Registry)
+//! refuses a key its plugin never asked for (a typo must not fall back to a default
+//! silently), with no list of known keys to keep by hand.
 
 use crate::{Error, Result};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
+use std::sync::{Arc, Mutex};
 
 /// One parameter value.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,14 +38,81 @@ impl std::fmt::Display for ParamValue {
     }
 }
 
-/// An ordered map of named parameters.
+/// An ordered map of named parameters, and the keys read from it so far when it is
+/// tracked ([`Params::tracked`]).
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct Params(pub BTreeMap<String, ParamValue>);
+pub struct Params(pub BTreeMap<String, ParamValue>, ReadLog);
+
+/// The keys asked of a tracked [`Params`] (shared by its clones); equal to any other log,
+/// so that parameters compare by their values only.
+#[derive(Debug, Clone, Default)]
+pub struct ReadLog(Option<Arc<Mutex<BTreeSet<String>>>>);
+
+impl PartialEq for ReadLog {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
 
 impl Params {
     /// Empty parameters: every plugin falls back to its defaults.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A copy of the values that notes every key its getters are asked for
+    /// ([`unread`](Self::unread), [`read_keys`](Self::read_keys)); the copy of a tracked
+    /// `Params` notes into the same log.
+    pub fn tracked(&self) -> Self {
+        match &self.1 .0 {
+            Some(_) => self.clone(),
+            None => Self(self.0.clone(), ReadLog(Some(Arc::default()))),
+        }
+    }
+
+    fn note(&self, key: &str) {
+        if let Some(log) = &self.1 .0 {
+            log.lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .insert(key.to_string());
+        }
+    }
+
+    /// The keys asked for so far (empty when not tracked), sorted.
+    pub fn read_keys(&self) -> Vec<String> {
+        match &self.1 .0 {
+            Some(log) => log
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .iter()
+                .cloned()
+                .collect(),
+            None => Vec::new(),
+        }
+    }
+
+    /// The keys present that no getter was asked for, sorted; empty when not tracked.
+    pub fn unread(&self) -> Vec<String> {
+        if self.1 .0.is_none() {
+            return Vec::new();
+        }
+        let read = self.read_keys();
+        self.0
+            .keys()
+            .filter(|k| !read.contains(k))
+            .cloned()
+            .collect()
+    }
+
+    /// The value of `key`, if present (noted as asked for).
+    pub fn get(&self, key: &str) -> Option<&ParamValue> {
+        self.note(key);
+        self.0.get(key)
+    }
+
+    /// Whether `key` is present (noted as asked for).
+    pub fn contains(&self, key: &str) -> bool {
+        self.get(key).is_some()
     }
 
     /// Builder-style insertion.
@@ -82,7 +153,7 @@ impl Params {
     /// A number, or `default` when absent. Errors when present with another type or
     /// not finite.
     pub fn num_or(&self, key: &str, default: f64) -> Result<f64> {
-        match self.0.get(key) {
+        match self.get(key) {
             None => Ok(default),
             Some(ParamValue::Num(x)) if x.is_finite() => Ok(*x),
             Some(other) => Err(Error::param(
@@ -94,10 +165,19 @@ impl Params {
 
     /// A required number.
     pub fn num(&self, key: &str) -> Result<f64> {
-        if !self.0.contains_key(key) {
+        if !self.contains(key) {
             return Err(Error::param(key, "required number is missing"));
         }
         self.num_or(key, f64::NAN)
+    }
+
+    /// An optional number: `None` when absent.
+    pub fn num_opt(&self, key: &str) -> Result<Option<f64>> {
+        if self.contains(key) {
+            self.num(key).map(Some)
+        } else {
+            Ok(None)
+        }
     }
 
     /// A non-negative integer, or `default` when absent.
@@ -114,7 +194,7 @@ impl Params {
 
     /// A string, or `default` when absent.
     pub fn str_or<'a>(&'a self, key: &str, default: &'a str) -> Result<&'a str> {
-        match self.0.get(key) {
+        match self.get(key) {
             None => Ok(default),
             Some(ParamValue::Str(s)) => Ok(s),
             Some(other) => Err(Error::param(key, format!("expected a string, got {other}"))),
@@ -123,7 +203,7 @@ impl Params {
 
     /// A list of numbers, or `default` when absent.
     pub fn list_or(&self, key: &str, default: &[f64]) -> Result<Vec<f64>> {
-        match self.0.get(key) {
+        match self.get(key) {
             None => Ok(default.to_vec()),
             Some(ParamValue::List(l)) => Ok(l.clone()),
             Some(other) => Err(Error::param(
@@ -133,20 +213,26 @@ impl Params {
         }
     }
 
-    /// Errors on any key not in `known`: a typo must not silently fall back to a default.
-    pub fn reject_unknown(&self, plugin: &str, known: &[&str]) -> Result<()> {
-        for k in self.0.keys() {
-            if !known.contains(&k.as_str()) {
-                return Err(Error::param(
+    /// Errors on the first key of a tracked copy that no getter asked for, naming what
+    /// `plugin` (of kind `kind`) does read.
+    pub fn refuse_unread(&self, kind: &str, plugin: &str) -> Result<()> {
+        match self.unread().first() {
+            None => Ok(()),
+            Some(k) => {
+                let read = self.read_keys();
+                Err(Error::param(
                     k.clone(),
                     format!(
-                        "unknown parameter for `{plugin}`; expected one of: {}",
-                        known.join(", ")
+                        "unknown parameter for {kind} `{plugin}`; {}",
+                        if read.is_empty() {
+                            "it takes none".to_string()
+                        } else {
+                            format!("it takes: {}", read.join(", "))
+                        }
                     ),
-                ));
+                ))
             }
         }
-        Ok(())
     }
 }
 
@@ -195,10 +281,26 @@ mod tests {
     }
 
     #[test]
-    fn unknown_keys_are_rejected_with_their_name() {
-        let p = Params::new().with_num("tolerance", 1.0);
-        let e = p.reject_unknown("x", &["tol"]).unwrap_err().to_string();
-        assert!(e.contains("tolerance") && e.contains("tol"), "{e}");
+    fn keys_no_getter_asked_for_are_refused_with_what_is_read() {
+        let p = Params::new()
+            .with_num("tolerance", 1.0)
+            .with_num("tol", 2.0)
+            .tracked();
+        assert_eq!(p.num_or("tol", 1.0).unwrap(), 2.0);
+        assert_eq!(p.num_or("absent", 3.0).unwrap(), 3.0);
+        assert_eq!(p.unread(), vec!["tolerance".to_string()]);
+        let e = p.refuse_unread("basis", "x").unwrap_err().to_string();
+        assert!(
+            e.contains("`tolerance`") && e.contains("absent, tol") && e.contains("basis `x`"),
+            "{e}"
+        );
+        // a key read through a clone counts too; an untracked copy refuses nothing
+        let q = p.clone();
+        assert!(q.contains("tolerance"));
+        assert!(p.refuse_unread("basis", "x").is_ok());
+        let plain = Params::new().with_num("tolerance", 1.0);
+        assert!(plain.unread().is_empty() && plain.refuse_unread("basis", "x").is_ok());
+        assert_eq!(plain, Params::new().with_num("tolerance", 1.0).tracked());
     }
 
     #[test]

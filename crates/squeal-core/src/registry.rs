@@ -38,10 +38,16 @@ impl<T: ?Sized> Table<T> {
             .insert(name.to_string(), (description.to_string(), Arc::new(ctor)));
     }
 
-    /// Builds the plugin `name` from `params`.
+    /// Builds the plugin `name` from `params`; a key the constructor never asked for is
+    /// refused ([`Params::refuse_unread`]).
     pub fn create(&self, name: &str, params: &Params) -> Result<Box<T>> {
         match self.entries.get(name) {
-            Some((_, ctor)) => ctor(params),
+            Some((_, ctor)) => {
+                let tracked = params.tracked();
+                let plugin = ctor(&tracked).map_err(|e| with_unread(e, &tracked.unread()))?;
+                tracked.refuse_unread(self.kind, name)?;
+                Ok(plugin)
+            }
             None => Err(Error::UnknownPlugin {
                 kind: self.kind,
                 name: name.to_string(),
@@ -61,6 +67,24 @@ impl<T: ?Sized> Table<T> {
             .iter()
             .map(|(k, (d, _))| (k.clone(), d.clone()))
             .collect()
+    }
+}
+
+/// A constructor's parameter error, with the keys given that it had not read when it
+/// failed (a misspelt key is often why a required one is missing).
+fn with_unread(e: Error, unread: &[String]) -> Error {
+    match e {
+        Error::Param { name, reason } if !unread.is_empty() => {
+            let keys: Vec<String> = unread.iter().map(|k| format!("`{k}`")).collect();
+            Error::Param {
+                name,
+                reason: format!(
+                    "{reason} (given and not read before this error: {})",
+                    keys.join(", ")
+                ),
+            }
+        }
+        other => other,
     }
 }
 
@@ -130,5 +154,13 @@ mod tests {
         let e = reg.materials.create("steel", &Params::new()).err().unwrap();
         let msg = e.to_string();
         assert!(msg.contains("steel") && msg.contains("unit"), "{msg}");
+        // a key the constructor never reads is refused, naming what it does read
+        let e = reg
+            .materials
+            .create("unit", &Params::new().with_num("rh0", 7.0))
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("rh0") && e.contains("it takes: rho"), "{e}");
     }
 }

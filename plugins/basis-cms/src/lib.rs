@@ -5,11 +5,11 @@
 //! mesoscopic plateau layouts) that costs no sparse eigen solve and no factorization per
 //! contact set.
 //!
-//! Once per model and set of candidate pairs the caller builds a
-//! [`FreeInterface`](squeal_core::FreeInterface) (normal modes of the unconstrained bodies
-//! up to `modes_factor x` the band top, static responses to unit contact loads and the
-//! residual contact flexibilities; [`squeal_core::synthesis`]). For each contact set and
-//! mu the basis then synthesizes the modes of the tied, frictional system by MacNeal's
+//! Once per model and set of candidate pairs, in its model stage
+//! ([`ReductionBasis::prepare`]), the basis builds a [`FreeInterface`] (normal modes of the
+//! unconstrained bodies up to `modes_factor x` the band top, static responses to unit
+//! contact loads and the residual contact flexibilities; [`synthesis`]) on the caller's
+//! factor of `K`. For each contact set and mu the basis then synthesizes the modes of the tied, frictional system by MacNeal's
 //! residual-flexibility method (an `m x m` eigenproblem, `m` free-interface modes, after
 //! one `nA x nA` LU), expands those up to `cutoff_factor x` the band top, and returns their
 //! real and imaginary parts, `M_c`-orthonormalized, as Ritz vectors of the exact operator:
@@ -27,18 +27,22 @@
 //!   `cutoff_factor x` band top.
 //! - `second_order` (default 1 = on, 0 = off): add, for each expanded mode, its
 //!   second-order residual direction `G2 B_A^T r` (the inertia of the residual flexibility,
-//!   corrected statically onto the ties; [`FreeInterface::correction`]), which the Ritz
-//!   step uses to recover most of what the static residual flexibility leaves out.
+//!   corrected statically onto the ties; [`FreeInterface::expand_with_correction`]), which
+//!   the Ritz step uses to recover most of what the static residual flexibility leaves out.
 //! - `rank_tol` (default [`DEFAULT_RANK_TOL`]): relative rank cut of the
 //!   orthonormalization.
-//!
-//! [`FreeInterface::correction`]: squeal_core::FreeInterface::correction
 
 use squeal_core::faer::Mat;
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{m_orthonormalize, DEFAULT_RANK_TOL};
-use squeal_core::{Basis, BasisRequest, Error, Params, ReductionBasis, Registry, Result};
-use std::time::Instant;
+use squeal_core::{
+    Basis, BasisRequest, Error, FreeModel, ModelStage, Params, ReductionBasis, Registry, Result,
+};
+use std::sync::Arc;
+
+pub mod synthesis;
+
+pub use synthesis::{FreeInterface, Synthesized};
 
 /// Name under which the basis is registered.
 pub const NAME: &str = "cms";
@@ -57,10 +61,6 @@ pub const DEFAULT_CUTOFF_FACTOR: f64 = 1.5;
 /// Registers the `"cms"` basis.
 pub fn register(reg: &mut Registry) {
     reg.bases.register(NAME, DESCRIPTION, |params: &Params| {
-        params.reject_unknown(
-            NAME,
-            &["modes_factor", "cutoff_factor", "rank_tol", "second_order"],
-        )?;
         let second_order = params.num_or("second_order", 1.0)?;
         if second_order != 0.0 && second_order != 1.0 {
             return Err(Error::param(
@@ -127,20 +127,39 @@ impl ReductionBasis for CmsBasis {
         true
     }
 
-    fn free_interface_cutoff(&self, band_top_hz: f64) -> Option<f64> {
-        Some(self.modes_factor * band_top_hz)
+    fn stage_key(&self, band_top_hz: f64) -> Option<String> {
+        Some(format!(
+            "{NAME}: free-interface modes to {} Hz",
+            self.modes_factor * band_top_hz
+        ))
+    }
+
+    /// The free-interface synthesis of the model on its candidate pairs, from the normal
+    /// modes up to `modes_factor x` the band top, on the caller's factor of `K` when it
+    /// has one.
+    fn prepare(&self, free: &FreeModel<'_>) -> Result<Option<ModelStage>> {
+        let modes = (free.normal_modes)(self.modes_factor * free.band_hz.1)?;
+        let fi = match &free.k_factor {
+            Some(factor) => {
+                FreeInterface::with_factor(free.k, free.m, free.pairs, &modes, factor.clone())?
+            }
+            None => FreeInterface::new(free.k, free.m, free.pairs, &modes)?,
+        };
+        Ok(Some(Arc::new(fi)))
     }
 
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {
-        let start = Instant::now();
-        let free = request.free.ok_or_else(|| {
-            Error::Invalid(
-                "the `cms` basis needs the free-interface synthesis of the model, which the \
-                 scene-based commands (stability, sweep, studies, bench with a scene) build; \
-                 an operator read from files has none"
-                    .into(),
-            )
-        })?;
+        let free = request
+            .stage
+            .and_then(|s| s.downcast_ref::<FreeInterface>())
+            .ok_or_else(|| {
+                Error::Invalid(
+                    "the `cms` basis needs the free-interface synthesis of the model, which \
+                     the scene-based commands (stability, sweep, studies, bench with a \
+                     scene) build; an operator read from files has none"
+                        .into(),
+                )
+            })?;
         let op = request.op;
         let active = free.active_in(op)?;
         let syn = free.synthesize(&active, request.mu)?;
@@ -198,7 +217,6 @@ impl ReductionBasis for CmsBasis {
         let (v, dropped) = m_orthonormalize(op.mc.as_ref(), raw.as_ref(), self.rank_tol)?;
         let mut basis = Basis::new(v);
         basis.dropped = dropped;
-        basis.mu = Some(request.mu);
         basis.notes.push(format!(
             "{NAME}: {} synthesized modes up to {cutoff:.1} Hz from {} free-interface modes \
              (to {:.1} Hz) and {} tied pairs of {} candidates, {} vectors ({dropped} removed \
@@ -210,7 +228,6 @@ impl ReductionBasis for CmsBasis {
             free.pairs(),
             basis.len()
         ));
-        basis.time_s = start.elapsed().as_secs_f64();
         Ok(basis)
     }
 }

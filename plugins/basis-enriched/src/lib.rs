@@ -27,7 +27,6 @@ use squeal_core::reduction::{
     m_svd_compress, StaticSolver, DEFAULT_RANK_TOL,
 };
 use squeal_core::{Basis, BasisRequest, Error, Params, ReductionBasis, Registry, Result};
-use std::time::Instant;
 
 /// Name under which the basis is registered.
 pub const NAME: &str = "enriched";
@@ -43,12 +42,7 @@ pub const DEFAULT_CUTOFF_FACTOR: f64 = 1.5;
 /// Registers the `"enriched"` basis.
 pub fn register(reg: &mut Registry) {
     reg.bases.register(NAME, DESCRIPTION, |params: &Params| {
-        params.reject_unknown(NAME, &["cutoff_factor", "svd_tol", "rank_tol"])?;
-        let svd_tol = if params.0.contains_key("svd_tol") {
-            Some(params.num("svd_tol")?)
-        } else {
-            None
-        };
+        let svd_tol = params.num_opt("svd_tol")?;
         let basis: Box<dyn ReductionBasis> = Box::new(EnrichedBasis::new(
             params.num_or("cutoff_factor", DEFAULT_CUTOFF_FACTOR)?,
             svd_tol,
@@ -91,7 +85,6 @@ impl ReductionBasis for EnrichedBasis {
     }
 
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {
-        let start = Instant::now();
         let op = request.op;
         let mc = op.mc.as_ref();
         let cutoff = self.cutoff_factor * request.band_hz.1;
@@ -129,7 +122,6 @@ impl ReductionBasis for EnrichedBasis {
             self.svd_tol.map_or(String::new(), |t| format!(" at {t:e}")),
             dropped_static
         ));
-        basis.time_s = start.elapsed().as_secs_f64();
         Ok(basis)
     }
 }

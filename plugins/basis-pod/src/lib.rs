@@ -68,17 +68,6 @@ pub const DEFAULT_SVD_TOL: f64 = 1e-8;
 /// Default of the `band_factor` parameter.
 pub const DEFAULT_BAND_FACTOR: f64 = 1.1;
 
-/// Every parameter key the basis reads.
-const KEYS: [&str; 7] = [
-    "snapshots",
-    "snapshot_count",
-    "snapshot_range",
-    "svd_tol",
-    "max_size",
-    "band_factor",
-    "rank_tol",
-];
-
 /// Registers the `"pod"` basis.
 pub fn register(reg: &mut Registry) {
     reg.bases.register(NAME, DESCRIPTION, |params: &Params| {
@@ -145,8 +134,8 @@ impl PodBasis {
 
     /// Reads the parameters of the module docs; unknown keys are refused.
     pub fn from_params(params: &Params) -> Result<Self> {
-        params.reject_unknown(NAME, &KEYS)?;
-        let has = |k: &str| params.0.contains_key(k);
+        let params = &params.tracked();
+        let has = |k: &str| params.contains(k);
         let snapshots = if has("snapshot_count") || has("snapshot_range") {
             if has("snapshots") {
                 return Err(Error::param(
@@ -169,7 +158,7 @@ impl PodBasis {
             let range = params.list_or("snapshot_range", &[])?;
             evenly_spaced(count, &range)?
         } else {
-            match params.0.get("snapshots") {
+            match params.get("snapshots") {
                 None => DEFAULT_SNAPSHOTS.to_vec(),
                 Some(ParamValue::Num(x)) => vec![*x],
                 Some(_) => params.list_or("snapshots", &[])?,
@@ -179,13 +168,15 @@ impl PodBasis {
             0 => None,
             m => Some(m),
         };
-        Self::new(
+        let basis = Self::new(
             snapshots,
             params.num_or("svd_tol", DEFAULT_SVD_TOL)?,
             max_size,
             params.num_or("band_factor", DEFAULT_BAND_FACTOR)?,
             params.num_or("rank_tol", DEFAULT_RANK_TOL)?,
-        )
+        )?;
+        params.refuse_unread("basis", NAME)?;
+        Ok(basis)
     }
 }
 
@@ -318,7 +309,6 @@ impl ReductionBasis for PodBasis {
             ),
         );
         basis.notes = notes;
-        basis.time_s = start.elapsed().as_secs_f64();
         Ok(basis)
     }
 }

@@ -54,19 +54,20 @@ fn operator(reg: &Registry) -> FrictionalOperator {
 fn build(reg: &Registry, opts: Params, op: &FrictionalOperator, arpack: &dyn EigenSolver) -> Basis {
     let dense = reg.eigen.create("dense", &Params::new()).unwrap();
     let ep = params(FMAX);
-    reg.bases
-        .create("pod", &opts)
-        .unwrap()
-        .build(&BasisRequest {
+    let pod = reg.bases.create("pod", &opts).unwrap();
+    squeal_core::contact::build_basis(
+        pod.as_ref(),
+        &BasisRequest {
             op,
             mu: 1.2,
             band_hz: (0.0, FMAX),
             modal: arpack,
             reduced: dense.as_ref(),
             params: &ep,
-            free: None,
-        })
-        .unwrap()
+            stage: None,
+        },
+    )
+    .unwrap()
 }
 
 /// Largest relative eigenvalue error `|lambda_r - lambda| / |lambda|` over the reference

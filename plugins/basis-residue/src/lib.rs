@@ -40,7 +40,6 @@ use squeal_core::reduction::{
 use squeal_core::{
     Basis, BasisRequest, EigenParams, Error, Params, ReductionBasis, Registry, Result,
 };
-use std::time::Instant;
 
 /// Name under which the basis is registered.
 pub const NAME: &str = "residue";
@@ -64,16 +63,6 @@ pub const TARGET_MARGIN: f64 = 0.02;
 /// Registers the `"residue"` basis.
 pub fn register(reg: &mut Registry) {
     reg.bases.register(NAME, DESCRIPTION, |params: &Params| {
-        params.reject_unknown(
-            NAME,
-            &[
-                "cutoff_factor",
-                "tol",
-                "max_iterations",
-                "shift_hz",
-                "rank_tol",
-            ],
-        )?;
         let basis: Box<dyn ReductionBasis> = Box::new(ResidueBasis::new(
             params.num_or("cutoff_factor", DEFAULT_CUTOFF_FACTOR)?,
             params.num_or("tol", DEFAULT_TOL)?,
@@ -138,7 +127,6 @@ impl ReductionBasis for ResidueBasis {
     }
 
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {
-        let start = Instant::now();
         let (op, mu) = (request.op, request.mu);
         let mc = op.mc.as_ref();
         let (fmin, fmax) = request.band_hz;
@@ -213,7 +201,6 @@ impl ReductionBasis for ResidueBasis {
         basis.projected = Some(projected);
         basis.dropped = dropped;
         basis.iterations = iterations;
-        basis.mu = Some(mu);
         basis.residual = Some(residual);
         notes.insert(
             0,
@@ -229,7 +216,6 @@ impl ReductionBasis for ResidueBasis {
             ),
         );
         basis.notes = notes;
-        basis.time_s = start.elapsed().as_secs_f64();
         Ok(basis)
     }
 }

@@ -138,17 +138,19 @@ fn run_basis(
     let basis = reg.bases.create(name, &p).unwrap();
     let dense = reg.eigen.create("dense", &Params::new()).unwrap();
     let ep = params(FMAX);
-    let b = basis
-        .build(&BasisRequest {
+    let b = squeal_core::build_basis(
+        basis.as_ref(),
+        &BasisRequest {
             op,
             mu,
             band_hz: (0.0, FMAX),
             modal,
             reduced: dense.as_ref(),
             params: &ep,
-            free: None,
-        })
-        .unwrap();
+            stage: None,
+        },
+    )
+    .unwrap();
     assert!(
         squeal_core::reduction::m_orthonormality_error(op.mc.as_ref(), b.v.as_ref()) < 1e-8,
         "{name}: basis not M-orthonormal"
@@ -317,11 +319,11 @@ fn residue_depends_on_mu_and_refuses_another_mu() {
         modal: arpack.as_ref(),
         reduced: dense.as_ref(),
         params: &ep,
-        free: None,
+        stage: None,
     };
     // a residue basis with one iteration allowed and a tight tolerance reports that it
     // stopped on the cap
-    let capped = reg
+    let residue = reg
         .bases
         .create(
             "residue",
@@ -329,9 +331,10 @@ fn residue_depends_on_mu_and_refuses_another_mu() {
                 .with_num("max_iterations", 1.0)
                 .with_num("tol", 1e-12),
         )
-        .unwrap()
-        .build(&req)
         .unwrap();
+    // the driver records the mu a mu-dependent basis belongs to
+    let capped = squeal_core::build_basis(residue.as_ref(), &req).unwrap();
+    assert_eq!(capped.mu, Some(0.7));
     assert_eq!(capped.iterations, 1);
     assert!(capped.residual.unwrap() > 1e-12);
     assert!(

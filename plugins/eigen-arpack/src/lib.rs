@@ -83,7 +83,7 @@ pub struct ArpackSolver;
 impl ArpackSolver {
     /// Builds the solver from plugin parameters; it takes none, so any key is an error.
     pub fn new(params: &Params) -> Result<Self> {
-        params.reject_unknown(NAME, &[])?;
+        params.tracked().refuse_unread("eigen", NAME)?;
         Ok(Self)
     }
 

@@ -43,7 +43,6 @@ pub const DEFAULT_MAX_DIM: usize = 3000;
 /// Registers the `"dense"` eigen solver.
 pub fn register(reg: &mut Registry) {
     reg.eigen.register(NAME, DESCRIPTION, |params: &Params| {
-        params.reject_unknown(NAME, &["max_dim"])?;
         let max_dim = params.usize_or("max_dim", DEFAULT_MAX_DIM)?;
         if max_dim == 0 {
             return Err(Error::param("max_dim", "must be at least 1"));

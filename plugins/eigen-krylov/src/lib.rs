@@ -150,8 +150,7 @@ const PAR_THRESHOLD: usize = 1 << 16;
 
 /// Registers the `"krylov"` eigen solver.
 pub fn register(reg: &mut Registry) {
-    reg.eigen.register(NAME, DESCRIPTION, |params: &Params| {
-        params.reject_unknown(NAME, &[])?;
+    reg.eigen.register(NAME, DESCRIPTION, |_: &Params| {
         let solver: Box<dyn EigenSolver> = Box::new(KrylovSolver);
         Ok(solver)
     });

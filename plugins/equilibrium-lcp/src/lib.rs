@@ -61,7 +61,6 @@ pub fn register(reg: &mut Registry) {
         "direct: condensation on the pairs after one factorization of K, exact LCP \
          (max_iterations)",
         |p| {
-            p.reject_unknown("lcp", &["max_iterations"])?;
             Ok(Box::new(LcpSolver {
                 max_iterations: p.usize_or("max_iterations", 1000)?,
             }))

@@ -106,7 +106,6 @@ pub fn register(reg: &mut Registry) {
         "fixed point on the friction forces with an inner Signorini active-set loop \
          (relaxation, tol, max_iterations)",
         |p| {
-            p.reject_unknown("lorang", &["relaxation", "tol", "max_iterations"])?;
             let relaxation = p.num_or("relaxation", 1.0)?;
             if !(relaxation > 0.0 && relaxation <= 1.0) {
                 return Err(Error::param(

@@ -42,10 +42,6 @@ pub fn register(reg: &mut Registry) {
         "isotropic",
         "isotropic linear elasticity (youngs_modulus_pa, poisson_ratio, density_kg_m3)",
         |p| {
-            p.reject_unknown(
-                "isotropic",
-                &["youngs_modulus_pa", "poisson_ratio", "density_kg_m3"],
-            )?;
             Isotropic::new(
                 p.num("youngs_modulus_pa")?,
                 p.num("poisson_ratio")?,
@@ -60,23 +56,7 @@ pub fn register(reg: &mut Registry) {
         "transversely isotropic linear elasticity about `axis` (in-plane and axial \
          moduli and Poisson ratios, optional axial shear modulus, density)",
         |p| {
-            p.reject_unknown(
-                "transversely_isotropic",
-                &[
-                    "youngs_modulus_in_plane_pa",
-                    "youngs_modulus_axial_pa",
-                    "poisson_ratio_in_plane",
-                    "poisson_ratio_axial",
-                    "shear_modulus_axial_pa",
-                    "axis",
-                    "density_kg_m3",
-                ],
-            )?;
-            let g = if p.0.contains_key("shear_modulus_axial_pa") {
-                Some(p.num("shear_modulus_axial_pa")?)
-            } else {
-                None
-            };
+            let g = p.num_opt("shear_modulus_axial_pa")?;
             let axis = p.list_or("axis", &[0.0, 0.0, 1.0])?;
             let axis: [f64; 3] = axis.as_slice().try_into().map_err(|_| {
                 Error::param(

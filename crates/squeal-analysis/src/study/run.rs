@@ -329,18 +329,21 @@ pub fn run(
     let limit = opts.max_cases.unwrap_or(usize::MAX);
     let remaining = todo.len().saturating_sub(limit);
     todo.truncate(limit);
-    // a basis working from the free-interface synthesis (`cms`) gets one, built here once
-    // for every pair of the face and shared by the workers
+    // a basis with a model stage (`cms`: the free-interface synthesis) gets it built here
+    // once for every pair of the face and shared by the workers
     let mut profile = Profile::new();
-    let free = if todo.is_empty() || probe.free_interface_cutoff().is_none() {
+    let stage = if todo.is_empty() || probe.stage_key().is_none() {
         None
     } else {
         let t = std::time::Instant::now();
         let all = ContactSet::new(model, &squeal_scene::Zone::Uniform, def.rotation)
             .map_err(PipelineError::from)?;
-        let free = probe.prepare_free_interface(model, &all)?;
-        profile.add("free-interface synthesis", t.elapsed().as_secs_f64());
-        free
+        let stage = probe.prepare_stage(model, &all)?;
+        profile.add(
+            &format!("model stage of `{}`", probe.basis_name),
+            t.elapsed().as_secs_f64(),
+        );
+        stage
     };
     drop(probe);
     progress(Progress::Start {
@@ -376,7 +379,7 @@ pub fn run(
     let next = std::sync::atomic::AtomicUsize::new(0);
     let worker = || match def.solve.method(registry) {
         Ok(mut method) => loop {
-            method.set_free_interface(free.clone());
+            method.set_stage(stage.clone());
             if failed() {
                 break;
             }

@@ -1,10 +1,11 @@
 //! The [`ReductionBasis`] plugin trait and the data it exchanges: the request
 //! ([`BasisRequest`]) and the basis it builds ([`Basis`]).
 
-use super::FrictionalOperator;
+use super::{FreeModel, FrictionalOperator, ModelStage};
 use crate::eigen::{EigenParams, EigenSolver};
-use crate::Result;
+use crate::{Error, Result};
 use faer::Mat;
+use std::any::Any;
 
 /// A real reduction basis on the constrained space, `M_c`-orthonormal
 /// (`V^T M_c V = I` to round-off), with how it was built.
@@ -12,14 +13,14 @@ use faer::Mat;
 pub struct Basis {
     /// Columns of the basis (`n_c x m`).
     pub v: Mat<f64>,
-    /// Wall time to build it (s).
+    /// Wall time to build it (s), set by [`build_basis`].
     pub time_s: f64,
     /// Candidate vectors removed by the rank cut (and the optional SVD compression).
     pub dropped: usize,
     /// Iterations (iterative bases), else 0.
     pub iterations: usize,
     /// Friction coefficient the basis was built for; `None` when it does not depend on mu
-    /// (valid for every mu of the contact set).
+    /// (valid for every mu of the contact set). Set by [`build_basis`].
     pub mu: Option<f64>,
     /// Final convergence measure of an iterative basis (the residue method's largest
     /// energy-norm residual of its target modes); `None` otherwise.
@@ -74,9 +75,10 @@ pub struct BasisRequest<'a> {
     pub reduced: &'a dyn EigenSolver,
     /// Tolerances and limits handed to both solvers (their band fields are overridden).
     pub params: &'a EigenParams,
-    /// The free-interface synthesis of the model, built once by the caller for a basis
-    /// that asks for it ([`ReductionBasis::free_interface_cutoff`]); `None` otherwise.
-    pub free: Option<&'a crate::synthesis::FreeInterface>,
+    /// The basis's own model stage ([`ReductionBasis::prepare`]), built once per model by
+    /// the caller for a basis that has one ([`ReductionBasis::stage_key`]); `None`
+    /// otherwise, or when the operator comes without its model (read from files).
+    pub stage: Option<&'a (dyn Any + Send + Sync)>,
 }
 
 /// Builds a reduction basis for one frictional operator.
@@ -92,15 +94,57 @@ pub trait ReductionBasis: Send + Sync {
     fn depends_on_mu(&self) -> bool {
         false
     }
-    /// The highest free-interface frequency (Hz) the basis needs when it works from a
-    /// [`FreeInterface`](crate::synthesis::FreeInterface) of the model, for a band whose
-    /// top is `band_top_hz`; `None` (the default) when it does not. The caller then builds
-    /// that synthesis once per model and candidate pairs and hands it to every
-    /// [`build`](Self::build) in [`BasisRequest::free`].
-    fn free_interface_cutoff(&self, band_top_hz: f64) -> Option<f64> {
+    /// The key of the model stage the basis needs for a band whose top is `band_top_hz`
+    /// (`None`, the default: no model stage). Bases whose keys are equal share one stage:
+    /// the key names the plugin and every parameter the stage depends on, e.g.
+    /// `cms: free modes to 15000 Hz`.
+    fn stage_key(&self, band_top_hz: f64) -> Option<String> {
         let _ = band_top_hz;
         None
     }
+    /// The model stage (see [`FreeModel`]): computed once per model from `free` by the
+    /// caller when [`stage_key`](Self::stage_key) is `Some`, and handed to every
+    /// [`build`](Self::build) in [`BasisRequest::stage`]. The default has nothing to
+    /// prepare.
+    fn prepare(&self, free: &FreeModel<'_>) -> Result<Option<ModelStage>> {
+        let _ = free;
+        Ok(None)
+    }
     /// Builds the basis described by `request`.
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis>;
+}
+
+/// Builds `basis` for `request` the way every caller should: checks the request (a finite
+/// mu, a band `0 <= fmin < fmax`), times the build into [`Basis::time_s`], records the mu
+/// the basis belongs to ([`Basis::mu`], from [`ReductionBasis::depends_on_mu`]) and checks
+/// the result (columns of the operator's size, at least one). A plugin's `build` only
+/// chooses its vectors.
+pub fn build_basis(basis: &dyn ReductionBasis, request: &BasisRequest<'_>) -> Result<Basis> {
+    let (fmin, fmax) = request.band_hz;
+    if !request.mu.is_finite() {
+        return Err(Error::param(
+            "mu",
+            format!("expected a finite friction coefficient, got {}", request.mu),
+        ));
+    }
+    if !(fmin.is_finite() && fmax.is_finite() && fmin >= 0.0 && fmin < fmax) {
+        return Err(Error::param(
+            "band_hz",
+            format!("expected 0 <= fmin < fmax (Hz), got [{fmin}, {fmax}]"),
+        ));
+    }
+    let start = std::time::Instant::now();
+    let mut built = basis.build(request)?;
+    if built.is_empty() || built.v.nrows() != request.op.dim() {
+        return Err(Error::Invalid(format!(
+            "basis `{}` returned {} x {} columns for an operator of {} DOFs",
+            basis.name(),
+            built.v.nrows(),
+            built.v.ncols(),
+            request.op.dim()
+        )));
+    }
+    built.time_s = start.elapsed().as_secs_f64();
+    built.mu = basis.depends_on_mu().then_some(request.mu);
+    Ok(built)
 }

@@ -13,10 +13,12 @@ mod equilibrium;
 mod law;
 mod lcp;
 mod operator;
+mod stage;
 
-pub use basis::{Basis, BasisRequest, ReductionBasis};
+pub use basis::{build_basis, Basis, BasisRequest, ReductionBasis};
 pub use condensation::{add_transpose_times, Condensation};
 pub use equilibrium::{check_mu, ContactProblem, Equilibrium, EquilibriumSolver};
 pub use law::ContactLaw;
 pub use lcp::{solve_lcp, LcpSolution};
 pub use operator::FrictionalOperator;
+pub use stage::{FreeModel, ModelStage, NormalModes, PairDofs};

@@ -304,7 +304,7 @@ fn backward_error_flags_a_perturbed_mode_and_a_truncated_basis() {
         modal: &Dense,
         reduced: &Dense,
         params: &wide_band(),
-        free: None,
+        stage: None,
     };
     let rm = coupled_real_modes(&req, 1e6).unwrap();
     let v8 = rm.vectors.as_ref().subcols(0, 8).to_owned();

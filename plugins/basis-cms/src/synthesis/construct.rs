@@ -2,12 +2,12 @@
 //! contact flexibilities) and what it tells about itself.
 
 use super::{add_pair_load, par, FreeInterface, PairDofs, Stored, STORE_LIMIT_BYTES};
-use crate::contact::FrictionalOperator;
-use crate::eigen::RealModes;
-use crate::linalg::Cholesky;
-use crate::{Error, Result, SparseMat, SparseRef};
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatRef};
+use squeal_core::faer::linalg::matmul::matmul;
+use squeal_core::faer::{Accum, Mat, MatRef};
+use squeal_core::linalg::Cholesky;
+use squeal_core::FrictionalOperator;
+use squeal_core::RealModes;
+use squeal_core::{Error, Result, SparseMat, SparseRef};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -27,7 +27,7 @@ const BLOCK: usize = 64;
 impl FreeInterface {
     /// Builds the free-interface data of the model `(k, m)` (free DOFs, `K` positive
     /// definite) for the candidate `pairs`, with the free-interface `modes` (of the same
-    /// `(K, M)`, `M`-orthonormal, e.g. from an [`EigenSolver`](crate::EigenSolver) up to a
+    /// `(K, M)`, `M`-orthonormal, e.g. from an [`EigenSolver`](squeal_core::EigenSolver) up to a
     /// cutoff above the band). The static responses of the pairs are stored when they fit
     /// in [`STORE_LIMIT_BYTES`], otherwise solved for each expansion.
     pub fn new(
@@ -56,7 +56,7 @@ impl FreeInterface {
     /// (by the contact condensation of the model, [`Condensation::factor`]): no second
     /// factorization.
     ///
-    /// [`Condensation::factor`]: crate::contact::Condensation::factor
+    /// [`Condensation::factor`]: squeal_core::contact::Condensation::factor
     pub fn with_factor(
         k: SparseRef<'_>,
         m: SparseRef<'_>,
@@ -187,7 +187,7 @@ impl FreeInterface {
         if let Some(st) = stored.as_mut() {
             // second-order residual terms K^-1 M K^-1 (Pn^T | Pt^T)
             for (z, y) in [(&st.zn, &mut st.yn), (&st.zt, &mut st.yt)] {
-                *y = crate::reduction::sparse_times(m, z.as_ref());
+                *y = squeal_core::linalg::sparse_times(m, z.as_ref());
                 solve_blocks(&factor, y);
             }
         }

@@ -2,9 +2,9 @@
 //! and their second-order residual correction ([`FreeInterface::correction`]).
 
 use super::{add_pair_load, par, FreeInterface, Synthesized};
-use crate::{c64, Error, Result};
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatRef};
+use squeal_core::faer::linalg::matmul::matmul;
+use squeal_core::faer::{Accum, Mat, MatRef};
+use squeal_core::{c64, Error, Result};
 
 impl FreeInterface {
     /// The unconstrained displacements `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r` of the
@@ -106,7 +106,7 @@ impl FreeInterface {
                     None => self.static_response(rfull.as_ref(), mu),
                 };
                 if second {
-                    let mut u = crate::reduction::sparse_times(self.m.as_ref(), z.as_ref());
+                    let mut u = squeal_core::linalg::sparse_times(self.m.as_ref(), z.as_ref());
                     self.factor.solve_in_place(u.as_mut());
                     u
                 } else {
@@ -173,7 +173,7 @@ impl FreeInterface {
                 w[(p.pin[2], c)] - w[(p.disc[2], c)]
             });
             let lu = waa.partial_piv_lu();
-            let cfix = faer::linalg::solvers::Solve::solve(&lu, &gaps);
+            let cfix = squeal_core::faer::linalg::solvers::Solve::solve(&lu, &gaps);
             if !(0..2 * k).all(|c| (0..na).all(|i| cfix[(i, c)].is_finite())) {
                 return Err(Error::Factorization {
                     what: format!("static contact flexibility ({na} pairs)"),

@@ -1,5 +1,5 @@
 //! Free-interface modal synthesis with residual flexibility (MacNeal) for a family of
-//! contact sets drawn from one set of candidate pairs: the machinery behind the `cms`
+//! contact sets drawn from one set of candidate pairs: the model stage of the `cms`
 //! basis, built once per model and region and then reused for every contact set and mu.
 //!
 //! For the active pairs `A` the linearized problem is the descriptor system
@@ -29,9 +29,9 @@
 //!
 //! Normals are `+e_z` (flat disc face), as in the operator builder.
 
-use crate::linalg::Cholesky;
-use crate::SparseMat;
-use faer::{Mat, Par};
+use squeal_core::faer::{Mat, Par};
+use squeal_core::linalg::Cholesky;
+use squeal_core::SparseMat;
 use std::sync::Arc;
 
 mod construct;
@@ -40,18 +40,8 @@ mod synthesize;
 #[cfg(test)]
 mod tests;
 
+pub use squeal_core::PairDofs;
 pub use synthesize::Synthesized;
-
-/// The DOFs of one candidate contact pair in the unconstrained (free) numbering.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PairDofs {
-    /// Pin node DOFs (x, y, z).
-    pub pin: [usize; 3],
-    /// Disc node DOFs (x, y, z).
-    pub disc: [usize; 3],
-    /// Unit in-plane sliding direction `e_i` (the friction on the pin points along it).
-    pub direction: [f64; 3],
-}
 
 /// The free-interface data of one model and one set of candidate pairs (see the module
 /// docs): modes, static contact responses and residual contact flexibilities.
@@ -95,7 +85,7 @@ struct Stored {
 pub const STORE_LIMIT_BYTES: usize = 3 << 30;
 
 fn par() -> Par {
-    faer::get_global_parallelism()
+    squeal_core::faer::get_global_parallelism()
 }
 
 /// Adds to column `c` of `x` the pair loads `Pn^T normal + Pt^T sliding` of pair `p`

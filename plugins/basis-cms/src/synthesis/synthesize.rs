@@ -2,9 +2,9 @@
 //! [`FreeInterface::synthesize`]).
 
 use super::{par, FreeInterface};
-use crate::{c64, Error, Result};
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat};
+use squeal_core::faer::linalg::matmul::matmul;
+use squeal_core::faer::{Accum, Mat};
+use squeal_core::{c64, Error, Result};
 
 /// The synthesized modes of one contact set at one mu.
 #[derive(Debug, Clone)]
@@ -76,7 +76,7 @@ impl FreeInterface {
                     ),
                 });
             }
-            x = faer::linalg::solvers::Solve::solve(&lu, &p);
+            x = squeal_core::faer::linalg::solvers::Solve::solve(&lu, &p);
             matmul(
                 a.as_mut(),
                 Accum::Add,
@@ -86,13 +86,14 @@ impl FreeInterface {
                 par(),
             );
         }
-        let eig = faer::linalg::solvers::Eigen::new_from_real(a.as_ref()).map_err(|e| {
-            Error::NotConverged {
-                method: "free-interface synthesis (dense eigen)".into(),
-                iterations: 0,
-                detail: format!("{e:?}"),
-            }
-        })?;
+        let eig =
+            squeal_core::faer::linalg::solvers::Eigen::new_from_real(a.as_ref()).map_err(|e| {
+                Error::NotConverged {
+                    method: "free-interface synthesis (dense eigen)".into(),
+                    iterations: 0,
+                    detail: format!("{e:?}"),
+                }
+            })?;
         let s: Vec<c64> = (0..nm).map(|k| eig.S()[k]).collect();
         let eta = eig.U().to_owned();
         let mut r = Mat::<c64>::zeros(na, nm);

@@ -2,10 +2,10 @@
 //! constrained spectrum is known densely.
 
 use super::*;
-use crate::eigen::{RealModes, SolveInfo};
-use crate::{c64, SparseMat};
-use faer::sparse::Triplet;
-use faer::Side;
+use squeal_core::faer::sparse::Triplet;
+use squeal_core::faer::Side;
+use squeal_core::{c64, SparseMat};
+use squeal_core::{RealModes, SolveInfo};
 
 const N: usize = 24;
 
