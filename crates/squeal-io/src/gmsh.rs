@@ -190,250 +190,26 @@ pub fn read_msh_bytes(bytes: &[u8], file: &Path) -> Result<Mesh, IoError> {
         file,
         last_line,
     };
-    // header
-    match p.peek() {
-        Some(("$MeshFormat", _)) => p.pos += 1,
-        Some((t, line)) => {
-            return Err(p.err(
-                Some(line),
-                format!("found `{t}` where the file should start with `$MeshFormat`"),
-                EXPECTED_FORMAT,
-            ))
-        }
-        None => return Err(p.err(Some(1), "the file is empty".into(), EXPECTED_FORMAT)),
-    }
-    let (version, vline) = p.next("the format version `4.1`")?;
-    let (ftype, _) = p.next("the file type `0` (ASCII)")?;
-    if version != "4.1" {
-        return Err(p.err(
-            Some(vline),
-            format!("MSH version `{version}` is not read"),
-            EXPECTED_FORMAT,
-        ));
-    }
-    if ftype != "0" {
-        return Err(p.err(
-            Some(vline),
-            format!("file type `{ftype}` (binary) is not read"),
-            EXPECTED_FORMAT,
-        ));
-    }
-    p.next("the data size (8)")?;
-    p.expect("$EndMeshFormat")?;
-
+    p.mesh_format()?;
     let mut names: HashMap<(usize, i64), String> = HashMap::new();
     let mut entity_phys: HashMap<(usize, i64), Vec<i64>> = HashMap::new();
     let mut nodes: HashMap<u64, [f64; 3]> = HashMap::new();
     let mut blocks: Vec<Block> = Vec::new();
     let (mut seen_nodes, mut seen_elements) = (false, false);
-
     while let Some((sec, line)) = p.peek() {
         p.pos += 1;
         match sec {
-            "$PhysicalNames" => {
-                let (n, _) = p.count("the number of physical names")?;
-                for _ in 0..n {
-                    let (dim, dline) = p.count("a physical dimension (0 to 3)")?;
-                    if dim > 3 {
-                        return Err(p.err(
-                            Some(dline),
-                            format!("physical dimension {dim}"),
-                            "a dimension 0 to 3",
-                        ));
-                    }
-                    let (tag, _) = p.int("a physical tag")?;
-                    let (name, nline) = p.next("a quoted physical name")?;
-                    let unq = name
-                        .strip_prefix('"')
-                        .and_then(|s| s.strip_suffix('"'))
-                        .ok_or_else(|| {
-                            p.err(
-                                Some(nline),
-                                format!("physical name {name} is not quoted"),
-                                "a name in double quotes",
-                            )
-                        })?;
-                    names.insert((dim, tag), unq.to_string());
-                }
-                p.expect("$EndPhysicalNames")?;
-            }
-            "$Entities" => {
-                let mut counts = [0usize; 4];
-                for c in counts.iter_mut() {
-                    *c = p
-                        .count("the numbers of points, curves, surfaces and volumes")?
-                        .0;
-                }
-                for (dim, &n) in counts.iter().enumerate() {
-                    for _ in 0..n {
-                        let (tag, _) = p.int("an entity tag")?;
-                        // a point has X Y Z, the others a bounding box
-                        for _ in 0..if dim == 0 { 3 } else { 6 } {
-                            p.real("entity coordinates")?;
-                        }
-                        let (np, _) = p.count("the number of physical tags")?;
-                        let mut phys = Vec::with_capacity(np.min(64));
-                        for _ in 0..np {
-                            phys.push(p.int("a physical tag")?.0);
-                        }
-                        if dim > 0 {
-                            let (nb, _) = p.count("the number of bounding entities")?;
-                            for _ in 0..nb {
-                                p.int("a bounding entity tag")?;
-                            }
-                        }
-                        entity_phys.insert((dim, tag), phys);
-                    }
-                }
-                p.expect("$EndEntities")?;
-            }
+            "$PhysicalNames" => p.physical_names(&mut names)?,
+            "$Entities" => p.entities(&mut entity_phys)?,
             "$Nodes" => {
                 seen_nodes = true;
-                let (nb, _) = p.count("the number of node entity blocks")?;
-                let (total, tline) = p.count("the number of nodes")?;
-                p.count("the minimum node tag")?;
-                p.count("the maximum node tag")?;
-                let mut found = 0usize;
-                for _ in 0..nb {
-                    let (dim, _) = p.count("the entity dimension of a node block")?;
-                    p.int("the entity tag of a node block")?;
-                    let (param, pline) = p.count("the parametric flag (0 or 1)")?;
-                    if param > 1 || dim > 3 {
-                        return Err(p.err(
-                            Some(pline),
-                            format!("node block of dimension {dim} with parametric flag {param}"),
-                            "a node block header `entityDim(0-3) entityTag parametric(0/1) numNodes`",
-                        ));
-                    }
-                    let (n, _) = p.count("the number of nodes in the block")?;
-                    let mut tags = Vec::with_capacity(n.min(1 << 20));
-                    for _ in 0..n {
-                        let (t, l) = p.count("a node tag")?;
-                        tags.push((t as u64, l));
-                    }
-                    for (t, l) in tags {
-                        let x = [
-                            p.real("node coordinates x y z")?,
-                            p.real("node coordinates x y z")?,
-                            p.real("node coordinates x y z")?,
-                        ];
-                        for _ in 0..param * dim {
-                            p.real("parametric node coordinates")?;
-                        }
-                        if nodes.insert(t, x).is_some() {
-                            return Err(p.err(
-                                Some(l),
-                                format!("node tag {t} is defined twice"),
-                                "each node tag defined once",
-                            ));
-                        }
-                    }
-                    found += n;
-                }
-                if found != total {
-                    return Err(p.err(
-                        Some(tline),
-                        format!("the header declares {total} nodes, the blocks hold {found}"),
-                        "numNodes equal to the sum of the blocks' node counts",
-                    ));
-                }
-                p.expect("$EndNodes")?;
+                p.nodes(&mut nodes)?;
             }
             "$Elements" => {
                 seen_elements = true;
-                let (nb, _) = p.count("the number of element entity blocks")?;
-                let (total, tline) = p.count("the number of elements")?;
-                p.count("the minimum element tag")?;
-                p.count("the maximum element tag")?;
-                let mut found = 0usize;
-                for _ in 0..nb {
-                    let (dim, dline) = p.count("the entity dimension of an element block")?;
-                    let (tag, _) = p.int("the entity tag of an element block")?;
-                    let (ty, tyline) = p.int("the element type")?;
-                    let (n, _) = p.count("the number of elements in the block")?;
-                    let Some((name, nn, tdim)) = element_type(ty) else {
-                        return Err(p.err(
-                            Some(tyline),
-                            format!("unknown element type {ty}"),
-                            EXPECTED_HEX,
-                        ));
-                    };
-                    if ![1, 3, 5, 15].contains(&ty) {
-                        return Err(p.err(
-                            Some(tyline),
-                            format!(
-                                "element type {ty} ({name}) in entity {tag} of dimension {tdim}"
-                            ),
-                            EXPECTED_HEX,
-                        ));
-                    }
-                    if dim != tdim {
-                        return Err(p.err(
-                            Some(dline),
-                            format!("a block of entity dimension {dim} holds {name}s (dimension {tdim})"),
-                            "element blocks whose entity dimension matches the element type",
-                        ));
-                    }
-                    let mut elements = Vec::with_capacity(n.min(1 << 20));
-                    for _ in 0..n {
-                        let (etag, eline) = p.count("an element tag")?;
-                        let mut v = Vec::with_capacity(nn);
-                        for _ in 0..nn {
-                            if p.peek().is_none_or(|(_, l)| l != eline) {
-                                return Err(p.err(
-                                    Some(eline),
-                                    format!("element {etag} has fewer than {nn} node tags"),
-                                    format!("`elementTag` and {nn} node tags on one line"),
-                                ));
-                            }
-                            let (t, _) = p.count(&format!("{nn} node tags of a {name}"))?;
-                            v.push(t as u64);
-                        }
-                        if p.peek().is_some_and(|(_, l)| l == eline) {
-                            return Err(p.err(
-                                Some(eline),
-                                format!("element {etag} has more than {nn} node tags"),
-                                format!("`elementTag` and {nn} node tags on one line"),
-                            ));
-                        }
-                        elements.push((etag as u64, eline, v));
-                    }
-                    found += n;
-                    blocks.push(Block {
-                        dim,
-                        tag,
-                        elements,
-                        hex: ty == 5,
-                    });
-                }
-                if found != total {
-                    return Err(p.err(
-                        Some(tline),
-                        format!("the header declares {total} elements, the blocks hold {found}"),
-                        "numElements equal to the sum of the blocks' element counts",
-                    ));
-                }
-                p.expect("$EndElements")?;
+                p.elements(&mut blocks)?;
             }
-            s if s.starts_with('$') && !s.starts_with("$End") => {
-                let end = format!("$End{}", &s[1..]);
-                loop {
-                    match p.peek() {
-                        Some((t, _)) if t == end => {
-                            p.pos += 1;
-                            break;
-                        }
-                        Some(_) => p.pos += 1,
-                        None => {
-                            return Err(p.err(
-                                Some(line),
-                                format!("section `{s}` is not closed (truncated?)"),
-                                format!("`{end}`"),
-                            ))
-                        }
-                    }
-                }
-            }
+            s if s.starts_with('$') && !s.starts_with("$End") => p.skip_section(s, line)?,
             other => {
                 return Err(p.err(
                     Some(line),
@@ -453,21 +229,24 @@ pub fn read_msh_bytes(bytes: &[u8], file: &Path) -> Result<Mesh, IoError> {
             "`$Nodes` and `$Elements` sections",
         ));
     }
+    let (mut mesh, index) = hex_mesh(&p, &nodes, &blocks)?;
+    node_sets(&p, &mut mesh, &index, &nodes, &blocks, &names, &entity_phys)?;
+    Ok(mesh)
+}
 
-    // the mesh: nodes used by hexahedra, in increasing tag order
-    let undefined = |etag: u64, line: usize, t: u64| {
-        p.err(
-            Some(line),
-            format!("element {etag} references node tag {t}, which $Nodes does not define"),
-            "node tags defined in $Nodes",
-        )
-    };
+/// The mesh of the hexahedra of `blocks`: the nodes they use, in increasing tag order
+/// (`index`: node tag to mesh node), each element checked and turned to a positive volume.
+fn hex_mesh(
+    p: &Parser<'_>,
+    nodes: &HashMap<u64, [f64; 3]>,
+    blocks: &[Block],
+) -> Result<(Mesh, HashMap<u64, usize>), IoError> {
     let mut used = BTreeSet::new();
     for b in blocks.iter().filter(|b| b.hex) {
         for (etag, line, v) in &b.elements {
             for &t in v {
                 if !nodes.contains_key(&t) {
-                    return Err(undefined(*etag, *line, t));
+                    return Err(undefined_node(p, *etag, *line, t));
                 }
                 used.insert(t);
             }
@@ -524,8 +303,29 @@ pub fn read_msh_bytes(bytes: &[u8], file: &Path) -> Result<Mesh, IoError> {
         }
     }
     mesh.hex_body = vec![0; mesh.hexes.len()];
+    Ok((mesh, index))
+}
 
-    // physical groups -> node sets
+/// An element that references a node `$Nodes` does not define.
+fn undefined_node(p: &Parser<'_>, etag: u64, line: usize, t: u64) -> IoError {
+    p.err(
+        Some(line),
+        format!("element {etag} references node tag {t}, which $Nodes does not define"),
+        "node tags defined in $Nodes",
+    )
+}
+
+/// The physical groups of dimension 0 to 2 as node sets of `mesh` (named by
+/// `$PhysicalNames`, else `physical_TAG`).
+fn node_sets(
+    p: &Parser<'_>,
+    mesh: &mut Mesh,
+    index: &HashMap<u64, usize>,
+    nodes: &HashMap<u64, [f64; 3]>,
+    blocks: &[Block],
+    names: &HashMap<(usize, i64), String>,
+    entity_phys: &HashMap<(usize, i64), Vec<i64>>,
+) -> Result<(), IoError> {
     let mut groups: BTreeMap<(usize, i64), BTreeSet<usize>> = BTreeMap::new();
     for ((dim, _), phys) in entity_phys.iter().filter(|((d, _), _)| *d < 3) {
         for &ph in phys {
@@ -541,7 +341,7 @@ pub fn read_msh_bytes(bytes: &[u8], file: &Path) -> Result<Mesh, IoError> {
             for (etag, line, v) in &b.elements {
                 for t in v {
                     if !nodes.contains_key(t) {
-                        return Err(undefined(*etag, *line, *t));
+                        return Err(undefined_node(p, *etag, *line, *t));
                     }
                     if let Some(&i) = index.get(t) {
                         set.insert(i);
@@ -560,7 +360,262 @@ pub fn read_msh_bytes(bytes: &[u8], file: &Path) -> Result<Mesh, IoError> {
         entry.sort_unstable();
         entry.dedup();
     }
-    Ok(mesh)
+    Ok(())
+}
+
+/// The sections of an MSH 4.1 file, each read by its own method.
+impl Parser<'_> {
+    /// `$MeshFormat`: version 4.1, ASCII.
+    fn mesh_format(&mut self) -> Result<(), IoError> {
+        match self.peek() {
+            Some(("$MeshFormat", _)) => self.pos += 1,
+            Some((t, line)) => {
+                return Err(self.err(
+                    Some(line),
+                    format!("found `{t}` where the file should start with `$MeshFormat`"),
+                    EXPECTED_FORMAT,
+                ))
+            }
+            None => return Err(self.err(Some(1), "the file is empty".into(), EXPECTED_FORMAT)),
+        }
+        let (version, vline) = self.next("the format version `4.1`")?;
+        let (ftype, _) = self.next("the file type `0` (ASCII)")?;
+        if version != "4.1" {
+            return Err(self.err(
+                Some(vline),
+                format!("MSH version `{version}` is not read"),
+                EXPECTED_FORMAT,
+            ));
+        }
+        if ftype != "0" {
+            return Err(self.err(
+                Some(vline),
+                format!("file type `{ftype}` (binary) is not read"),
+                EXPECTED_FORMAT,
+            ));
+        }
+        self.next("the data size (8)")?;
+        self.expect("$EndMeshFormat")?;
+        Ok(())
+    }
+
+    /// `$PhysicalNames` into `names` (by dimension and physical tag).
+    fn physical_names(&mut self, names: &mut HashMap<(usize, i64), String>) -> Result<(), IoError> {
+        let (n, _) = self.count("the number of physical names")?;
+        for _ in 0..n {
+            let (dim, dline) = self.count("a physical dimension (0 to 3)")?;
+            if dim > 3 {
+                return Err(self.err(
+                    Some(dline),
+                    format!("physical dimension {dim}"),
+                    "a dimension 0 to 3",
+                ));
+            }
+            let (tag, _) = self.int("a physical tag")?;
+            let (name, nline) = self.next("a quoted physical name")?;
+            let unq = name
+                .strip_prefix('"')
+                .and_then(|s| s.strip_suffix('"'))
+                .ok_or_else(|| {
+                    self.err(
+                        Some(nline),
+                        format!("physical name {name} is not quoted"),
+                        "a name in double quotes",
+                    )
+                })?;
+            names.insert((dim, tag), unq.to_string());
+        }
+        self.expect("$EndPhysicalNames")?;
+        Ok(())
+    }
+
+    /// `$Entities`: the physical tags of every entity, into `entity_phys`.
+    fn entities(
+        &mut self,
+        entity_phys: &mut HashMap<(usize, i64), Vec<i64>>,
+    ) -> Result<(), IoError> {
+        let mut counts = [0usize; 4];
+        for c in counts.iter_mut() {
+            *c = self
+                .count("the numbers of points, curves, surfaces and volumes")?
+                .0;
+        }
+        for (dim, &n) in counts.iter().enumerate() {
+            for _ in 0..n {
+                let (tag, _) = self.int("an entity tag")?;
+                // a point has X Y Z, the others a bounding box
+                for _ in 0..if dim == 0 { 3 } else { 6 } {
+                    self.real("entity coordinates")?;
+                }
+                let (np, _) = self.count("the number of physical tags")?;
+                let mut phys = Vec::with_capacity(np.min(64));
+                for _ in 0..np {
+                    phys.push(self.int("a physical tag")?.0);
+                }
+                if dim > 0 {
+                    let (nb, _) = self.count("the number of bounding entities")?;
+                    for _ in 0..nb {
+                        self.int("a bounding entity tag")?;
+                    }
+                }
+                entity_phys.insert((dim, tag), phys);
+            }
+        }
+        self.expect("$EndEntities")?;
+        Ok(())
+    }
+
+    /// `$Nodes` into `nodes` (by node tag).
+    fn nodes(&mut self, nodes: &mut HashMap<u64, [f64; 3]>) -> Result<(), IoError> {
+        let (nb, _) = self.count("the number of node entity blocks")?;
+        let (total, tline) = self.count("the number of nodes")?;
+        self.count("the minimum node tag")?;
+        self.count("the maximum node tag")?;
+        let mut found = 0usize;
+        for _ in 0..nb {
+            let (dim, _) = self.count("the entity dimension of a node block")?;
+            self.int("the entity tag of a node block")?;
+            let (param, pline) = self.count("the parametric flag (0 or 1)")?;
+            if param > 1 || dim > 3 {
+                return Err(self.err(
+                    Some(pline),
+                    format!("node block of dimension {dim} with parametric flag {param}"),
+                    "a node block header `entityDim(0-3) entityTag parametric(0/1) numNodes`",
+                ));
+            }
+            let (n, _) = self.count("the number of nodes in the block")?;
+            let mut tags = Vec::with_capacity(n.min(1 << 20));
+            for _ in 0..n {
+                let (t, l) = self.count("a node tag")?;
+                tags.push((t as u64, l));
+            }
+            for (t, l) in tags {
+                let x = [
+                    self.real("node coordinates x y z")?,
+                    self.real("node coordinates x y z")?,
+                    self.real("node coordinates x y z")?,
+                ];
+                for _ in 0..param * dim {
+                    self.real("parametric node coordinates")?;
+                }
+                if nodes.insert(t, x).is_some() {
+                    return Err(self.err(
+                        Some(l),
+                        format!("node tag {t} is defined twice"),
+                        "each node tag defined once",
+                    ));
+                }
+            }
+            found += n;
+        }
+        if found != total {
+            return Err(self.err(
+                Some(tline),
+                format!("the header declares {total} nodes, the blocks hold {found}"),
+                "numNodes equal to the sum of the blocks' node counts",
+            ));
+        }
+        self.expect("$EndNodes")?;
+        Ok(())
+    }
+
+    /// `$Elements` into `blocks` (only points, lines, quadrangles and hexahedra).
+    fn elements(&mut self, blocks: &mut Vec<Block>) -> Result<(), IoError> {
+        let (nb, _) = self.count("the number of element entity blocks")?;
+        let (total, tline) = self.count("the number of elements")?;
+        self.count("the minimum element tag")?;
+        self.count("the maximum element tag")?;
+        let mut found = 0usize;
+        for _ in 0..nb {
+            let (dim, dline) = self.count("the entity dimension of an element block")?;
+            let (tag, _) = self.int("the entity tag of an element block")?;
+            let (ty, tyline) = self.int("the element type")?;
+            let (n, _) = self.count("the number of elements in the block")?;
+            let Some((name, nn, tdim)) = element_type(ty) else {
+                return Err(self.err(
+                    Some(tyline),
+                    format!("unknown element type {ty}"),
+                    EXPECTED_HEX,
+                ));
+            };
+            if ![1, 3, 5, 15].contains(&ty) {
+                return Err(self.err(
+                    Some(tyline),
+                    format!("element type {ty} ({name}) in entity {tag} of dimension {tdim}"),
+                    EXPECTED_HEX,
+                ));
+            }
+            if dim != tdim {
+                return Err(self.err(
+                    Some(dline),
+                    format!("a block of entity dimension {dim} holds {name}s (dimension {tdim})"),
+                    "element blocks whose entity dimension matches the element type",
+                ));
+            }
+            let mut elements = Vec::with_capacity(n.min(1 << 20));
+            for _ in 0..n {
+                let (etag, eline) = self.count("an element tag")?;
+                let mut v = Vec::with_capacity(nn);
+                for _ in 0..nn {
+                    if self.peek().is_none_or(|(_, l)| l != eline) {
+                        return Err(self.err(
+                            Some(eline),
+                            format!("element {etag} has fewer than {nn} node tags"),
+                            format!("`elementTag` and {nn} node tags on one line"),
+                        ));
+                    }
+                    let (t, _) = self.count(&format!("{nn} node tags of a {name}"))?;
+                    v.push(t as u64);
+                }
+                if self.peek().is_some_and(|(_, l)| l == eline) {
+                    return Err(self.err(
+                        Some(eline),
+                        format!("element {etag} has more than {nn} node tags"),
+                        format!("`elementTag` and {nn} node tags on one line"),
+                    ));
+                }
+                elements.push((etag as u64, eline, v));
+            }
+            found += n;
+            blocks.push(Block {
+                dim,
+                tag,
+                elements,
+                hex: ty == 5,
+            });
+        }
+        if found != total {
+            return Err(self.err(
+                Some(tline),
+                format!("the header declares {total} elements, the blocks hold {found}"),
+                "numElements equal to the sum of the blocks' element counts",
+            ));
+        }
+        self.expect("$EndElements")?;
+        Ok(())
+    }
+
+    /// Skips a section `s` the reader does not use (opened on `line`).
+    fn skip_section(&mut self, s: &str, line: usize) -> Result<(), IoError> {
+        let end = format!("$End{}", &s[1..]);
+        loop {
+            match self.peek() {
+                Some((t, _)) if t == end => {
+                    self.pos += 1;
+                    break;
+                }
+                Some(_) => self.pos += 1,
+                None => {
+                    return Err(self.err(
+                        Some(line),
+                        format!("section `{s}` is not closed (truncated?)"),
+                        format!("`{end}`"),
+                    ))
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Name of the physical volume [`write_msh`] puts every hexahedron in.
