@@ -14,7 +14,7 @@ Why not `eigs(K~, M=M~, sigma=...)`: SciPy's generalized mode requires M to be r
 symmetric (ARPACK's B inner product), and M~ = Mc - mu FM is not; the shift-invert operator
 is therefore passed as a LinearOperator in standard mode, exactly as squeal does.
 
-Windows follow squeal's band driver (crates/squeal-core/src/qep.rs, solve_qep_band_with):
+Windows follow squeal's band driver (crates/squeal-core/src/qep/band.rs):
 a window [lo, hi] Hz has sigma = ((2 pi lo)^2 + (2 pi hi)^2) / 2 and radius
 R = 1.05 (b - a) / 2 + 0.01 (2 pi hi)^2; k starts at 24 and doubles until one converged
 eigenvalue lies outside |s - sigma| > R (then every eigenvalue inside has been found);
@@ -198,16 +198,28 @@ def compare(squeal, modes):
     return out
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+def parse_args(ap, peer_json):
+    """Adds the arguments both comparisons take to `ap` and parses them; returns the
+    arguments, squeal's output (or None) and the band: `--band`, else squeal's, else 0-5 kHz."""
     ap.add_argument("operator", type=Path, help="operator directory (squeal export --out DIR)")
     ap.add_argument("--mu", type=float, required=True)
-    ap.add_argument("--band", default="0:10000", help="FMIN:FMAX in Hz (default 0:10000)")
+    ap.add_argument("--band", default=None,
+                    help="FMIN:FMAX in Hz (default: squeal's band from --squeal-json, else 0:5000)")
     ap.add_argument("--tol", type=float, default=1e-12)
     ap.add_argument("--squeal-json", type=Path, help="`squeal stability --json` output")
-    ap.add_argument("--out", type=Path, default=None, help="scipy.json path")
+    ap.add_argument("--out", type=Path, default=None, help=f"{peer_json} path")
     args = ap.parse_args()
-    fmin, fmax = (float(x) for x in args.band.split(":"))
+    sq = json.loads(args.squeal_json.read_text()) if args.squeal_json else None
+    if args.band:
+        fmin, fmax = (float(x) for x in args.band.split(":"))
+    else:
+        fmin, fmax = sq["band_hz"] if sq else (0.0, 5000.0)
+    return args, sq, fmin, fmax
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    args, sq, fmin, fmax = parse_args(ap, "scipy.json")
 
     t0 = time.perf_counter()
     m, k = load_operator(args.operator, args.mu)
@@ -215,48 +227,58 @@ def main():
     print(f"SciPy {scipy.__version__}, NumPy {np.__version__}: operator n = {m.shape[0]}, "
           f"nnz(M~) = {m.nnz}, nnz(K~) = {k.nnz}, read in {load_s:.2f}s", file=sys.stderr)
     lam, eta, solve_s, band = solve_band(m, k, fmin, fmax, args.tol)
-    modes = [{"freq_hz": l.imag / TWO_PI, "re": l.real, "im": l.imag,
-              "dvr": l.real / l.imag, "backward_error": float(e)} for l, e in zip(lam, eta)]
     report = {
         "solver": "scipy.sparse.linalg.eigs (ARPACK) on splu(K~ - sigma M~)^-1 M~",
         "scipy": scipy.__version__, "numpy": np.__version__,
-        "mu": args.mu, "band_hz": [fmin, fmax], "tol": args.tol, "dofs": m.shape[0],
-        "time_s": solve_s, "load_s": load_s, "factor_s": band.factor_s,
-        "windows": band.windows, "factorizations": band.factorizations,
-        "op_applications": band.applications, "notes": band.notes,
+        "factor_s": band.factor_s, "op_applications": band.applications,
+    }
+    extra = [("total time incl. reading (s)", f"{sq['time_s']:.2f}" if sq else "",
+              f"{solve_s + load_s:.2f}")]
+    write_and_compare("SciPy", "SciPy eigs", args, (fmin, fmax), m.shape[0], lam, eta, solve_s,
+                      load_s, band, report, sq, extra, args.out or (args.operator / "scipy.json"))
+
+
+def write_and_compare(peer, column, args, band_hz, dofs, lam, eta, solve_s, load_s, band,
+                      report, sq, extra_rows, out):
+    """Completes `report` with the modes and the run's figures, writes it to `out` and,
+    given squeal's output `sq`, adds the comparison and prints the side-by-side table
+    (`extra_rows` after the solve time) with the speed ratio and the largest differences."""
+    modes = [{"freq_hz": l.imag / TWO_PI, "re": l.real, "im": l.imag,
+              "dvr": l.real / l.imag, "backward_error": float(e)} for l, e in zip(lam, eta)]
+    report.update({
+        "mu": args.mu, "band_hz": list(band_hz), "tol": args.tol, "dofs": dofs,
+        "time_s": solve_s, "load_s": load_s,
+        "windows": band.windows, "factorizations": band.factorizations, "notes": band.notes,
         "max_backward_error": float(eta.max()) if len(eta) else 0.0,
         "modes": modes,
-    }
-    out = args.out or (args.operator / "scipy.json")
+    })
     out.write_text(json.dumps(report, indent=1))
     print(f"wrote {out}: {len(modes)} modes in {solve_s:.2f}s", file=sys.stderr)
-
-    if args.squeal_json:
-        sq = json.loads(args.squeal_json.read_text())
-        c = compare(sq, modes)
-        report["comparison"] = c
-        out.write_text(json.dumps(report, indent=1))
-        rows = [
-            ("solve time (s)", f"{sq['solve_time_s']:.2f}", f"{solve_s:.2f}"),
-            ("total time incl. reading (s)", f"{sq['time_s']:.2f}", f"{solve_s + load_s:.2f}"),
-            ("modes in band", str(len(sq["modes"])), str(len(modes))),
-            ("unstable modes", str(c["unstable_squeal"]), str(c["unstable_scipy"])),
-            ("factorizations", str(sq.get("factorizations", "?")), str(band.factorizations)),
-            ("worst backward error", f"{sq['max_backward_error']:.2e}",
-             f"{report['max_backward_error']:.2e}"),
-        ]
-        w = max(len(r[0]) for r in rows)
-        print(f"\n{'mu = ' + str(args.mu) + ', ' + str(m.shape[0]) + ' DOFs':<{w}}  "
-              f"{'squeal arpack':>14}  {'SciPy eigs':>14}")
-        for name, a, b in rows:
-            print(f"{name:<{w}}  {a:>14}  {b:>14}")
-        print(f"speed ratio SciPy / squeal (solve): {solve_s / max(sq['solve_time_s'], 1e-9):.2f}")
-        print(f"matched modes: {c['squeal_modes'] - c['unmatched_squeal']} "
-              f"(unmatched: squeal {c['unmatched_squeal']}, SciPy {c['unmatched_scipy']})")
-        print(f"max relative frequency difference: {c['max_rel_freq_diff']:.2e}")
-        print(f"max |Re(lambda)| difference: {c['max_abs_re_diff']:.2e} 1/s "
-              f"(max |DvR| difference {c['max_abs_dvr_diff']:.2e})")
-
+    if not sq:
+        return
+    c = compare(sq, modes)
+    report["comparison"] = c
+    out.write_text(json.dumps(report, indent=1))
+    rows = [("solve time (s)", f"{sq['solve_time_s']:.2f}", f"{solve_s:.2f}")] + extra_rows + [
+        ("modes in band", str(len(sq["modes"])), str(len(modes))),
+        ("unstable modes", str(c["unstable_squeal"]), str(c["unstable_scipy"])),
+        ("factorizations", str(sq.get("factorizations", "?")), str(band.factorizations)),
+        ("worst backward error", f"{sq['max_backward_error']:.2e}",
+         f"{report['max_backward_error']:.2e}"),
+    ]
+    w = max(len(r[0]) for r in rows)
+    print(f"\n{'mu = ' + str(args.mu) + ', ' + str(dofs) + ' DOFs':<{w}}  "
+          f"{'squeal arpack':>14}  {column:>14}")
+    for name, a, b in rows:
+        print(f"{name:<{w}}  {a:>14}  {b:>14}")
+    if "settings" in report:
+        print(f"{peer} settings: {report['settings']}")
+    print(f"speed ratio {peer} / squeal (solve): {solve_s / max(sq['solve_time_s'], 1e-9):.2f}")
+    print(f"matched modes: {c['squeal_modes'] - c['unmatched_squeal']} "
+          f"(unmatched: squeal {c['unmatched_squeal']}, {peer} {c['unmatched_scipy']})")
+    print(f"max relative frequency difference: {c['max_rel_freq_diff']:.2e}")
+    print(f"max |Re(lambda)| difference: {c['max_abs_re_diff']:.2e} 1/s "
+          f"(max |DvR| difference {c['max_abs_dvr_diff']:.2e})")
 
 if __name__ == "__main__":
     main()

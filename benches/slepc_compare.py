@@ -1,0 +1,216 @@
+#!/usr/bin/env python3
+"""Solve squeal's frictional QEP band with SLEPc and compare with squeal's own solve.
+
+Reads an operator directory written by `squeal export` (Mc.mtx, Kc.mtx, FM.mtx, FK.mtx),
+forms M~ = Mc - mu FM and K~ = Kc - mu FK (C = 0) and finds every mode of the band as a
+generalized non-Hermitian eigenproblem in s = -lambda^2, the linearization a SLEPc user
+picks when there is no damping:
+
+    (K~ - s M~) u = 0,   EPS type krylovschur, problem type GNHEP,
+    ST sinvert with target sigma (EPS_TARGET_MAGNITUDE),
+    KSP preonly + PC lu with MUMPS (`--ordering` picks MUMPS's ICNTL(7)),
+    tolerance `--tol` on SLEPc's relative error estimate (EPS_CONV_REL).
+
+The band is squeal's (`band_hz` of its `stability --json`), unless `--band` says otherwise.
+Windows, nev doubling and the split rule are those of squeal's band driver and of
+`scipy_compare.py`: a window [lo, hi] Hz has sigma = ((2 pi lo)^2 + (2 pi hi)^2) / 2 and
+radius R = 1.05 (b - a) / 2 + 0.01 (2 pi hi)^2; nev starts at 24 and doubles until one
+converged eigenvalue lies outside |s - sigma| > R. The EPS object (and with it the MUMPS
+factor of K~ - sigma M~) is kept while nev grows: one factorization per window.
+Backward errors, the matching of modes and the side-by-side table are `scipy_compare.py`'s.
+
+Writes slepc.json and, given squeal's `stability --json` output, prints the comparison.
+"""
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from scipy_compare import (REAL_ROOT_REL, TWO_PI, backward_errors,  # noqa: E402
+                           load_operator, parse_args, write_and_compare)
+
+import petsc4py  # noqa: E402
+
+# the event log counts MUMPS factorizations (MatLUFactorNum); its report goes nowhere
+petsc4py.init(sys.argv[:1] + ["-log_view", ":/dev/null"])
+from petsc4py import PETSc  # noqa: E402
+import slepc4py  # noqa: E402
+
+slepc4py.init(sys.argv[:1])
+from slepc4py import SLEPc  # noqa: E402
+
+# MUMPS orderings: sequential analysis (ICNTL(28) = 1) with ICNTL(7), or parallel analysis
+# (ICNTL(28) = 2) with ICNTL(29); MUMPS falls back to another ordering when the one asked
+# for is not in its build, so the one used (INFOG(7)) is reported.
+ORDERINGS = {"auto": (1, 7), "amd": (1, 0), "amf": (1, 2), "scotch": (1, 3), "pord": (1, 4),
+             "metis": (1, 5), "qamd": (1, 6), "ptscotch": (2, 1), "parmetis": (2, 2)}
+USED = {0: "amd", 1: "given", 2: "amf", 3: "scotch", 4: "pord", 5: "metis", 6: "qamd"}
+
+
+def petsc_matrix(a):
+    a = a.tocsr()
+    a.sort_indices()
+    return PETSc.Mat().createAIJ(size=a.shape, csr=(a.indptr, a.indices, a.data))
+
+
+class SlepcBand:
+    """squeal's band driver on SLEPc's Krylov-Schur with MUMPS shift-and-invert."""
+
+    def __init__(self, m, k, tol, ordering, max_nev=400, nev0=24, radius_factor=1.05,
+                 margin_rel=0.01, max_depth=10):
+        self.m, self.k = m, k
+        self.pm, self.pk = petsc_matrix(m), petsc_matrix(k)
+        self.n = m.shape[0]
+        self.tol, self.ordering = tol, ordering
+        self.cap = max(1, min(max_nev, self.n - 2))
+        self.nev0, self.max_depth = nev0, max_depth
+        self.radius_factor, self.margin_rel = radius_factor, margin_rel
+        self.lam, self.vecs = [], []
+        self.windows = self.factorizations = 0
+        self.ordering_used = None
+        self.factor_entries = None
+        self.setup_s = 0.0
+        self.notes = []
+
+    def eps(self, sigma):
+        opts = PETSc.Options()
+        analysis, order = ORDERINGS[self.ordering]
+        # the options of the factor matrix carry the ST's prefix
+        opts["st_mat_mumps_icntl_28"] = analysis
+        opts["st_mat_mumps_icntl_7" if analysis == 1 else "st_mat_mumps_icntl_29"] = order
+        e = SLEPc.EPS().create()
+        e.setOperators(self.pk, self.pm)
+        e.setProblemType(SLEPc.EPS.ProblemType.GNHEP)
+        e.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
+        e.setTarget(sigma)
+        e.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
+        e.setTolerances(self.tol, 100000)
+        e.setConvergenceTest(SLEPc.EPS.Conv.REL)
+        st = e.getST()
+        st.setType(SLEPc.ST.Type.SINVERT)
+        st.setShift(sigma)
+        ksp = st.getKSP()
+        ksp.setType(PETSc.KSP.Type.PREONLY)
+        pc = ksp.getPC()
+        pc.setType(PETSc.PC.Type.LU)
+        pc.setFactorSolverType("mumps")
+        e.setFromOptions()
+        return e
+
+    def window(self, lo, hi, depth, nev0):
+        a, b = (TWO_PI * lo) ** 2, (TWO_PI * hi) ** 2
+        sigma = 0.5 * (a + b)
+        radius = self.radius_factor * 0.5 * (b - a) + self.margin_rel * (TWO_PI * hi) ** 2
+        e = self.eps(sigma)
+        nev = min(max(nev0, 1), self.cap)
+        e.setDimensions(nev=nev)
+        t0 = time.perf_counter()
+        e.setUp()  # the MUMPS factorization of K~ - sigma M~
+        self.setup_s += time.perf_counter() - t0
+        factor = e.getST().getKSP().getPC().getFactorMatrix()
+        self.ordering_used = USED.get(factor.getMumpsInfog(7), str(factor.getMumpsInfog(7)))
+        # INFOG(29): entries in the factors (negative: in millions)
+        entries = factor.getMumpsInfog(29)
+        self.factor_entries = entries if entries >= 0 else -entries * 1_000_000
+        self.factorizations += 1
+        while True:
+            e.setDimensions(nev=nev)
+            e.solve()
+            nconv = e.getConverged()
+            s = np.array([e.getEigenvalue(i) for i in range(nconv)], dtype=complex)
+            reach = np.max(np.abs(s - sigma)) if nconv else 0.0
+            if nconv < nev:
+                self.notes.append(f"window [{lo:.6g}, {hi:.6g}] Hz: {nconv}/{nev} converged")
+                break
+            if reach > radius:
+                break
+            if nev >= self.cap:
+                if depth < self.max_depth:
+                    mid = 0.5 * (lo + hi)
+                    nxt = min(max(nev // 2, self.nev0), self.cap)
+                    self.notes.append(f"window [{lo:.6g}, {hi:.6g}] Hz split")
+                    e.destroy()
+                    self.window(lo, mid, depth + 1, nxt)
+                    self.window(mid, hi, depth + 1, nxt)
+                    return
+                self.notes.append(f"window [{lo:.6g}, {hi:.6g}] Hz not covered")
+                break
+            nev = min(2 * nev, self.cap)
+        self.windows += 1
+        its = e.getIterationNumber()
+        print(f"  slepc window [{lo:.0f}, {hi:.0f}] Hz: nev = {nev}, {nconv} converged, "
+              f"{its} restarts", file=sys.stderr)
+        vr, vi = self.pk.createVecs()
+        slack = 1e-8 * hi
+        before = len(self.lam)
+        matched = [False] * before
+        for j in range(nconv):
+            sj = e.getEigenpair(j, vr, vi)
+            lam = 1j * np.sqrt(complex(sj))  # principal root: Im(lambda) >= 0
+            if not np.isfinite(lam) or lam.imag <= 0.0:
+                continue
+            f = lam.imag / TWO_PI
+            if f < lo - slack or f > hi + slack:
+                continue
+            tol = max(1e-8 * abs(lam), 100.0 * self.tol * abs(lam))
+            dup = next((p for p in range(before)
+                        if not matched[p] and abs(self.lam[p] - lam) <= tol), None)
+            if dup is not None:
+                matched[dup] = True
+                continue
+            self.lam.append(lam)
+            self.vecs.append(vr.getArray().copy() + 1j * vi.getArray().copy())
+        e.destroy()
+
+
+def solve_band(m, k, fmin, fmax, tol, ordering):
+    band = SlepcBand(m, k, tol, ordering)
+    t0 = time.perf_counter()
+    band.window(fmin, fmax, 0, band.nev0)
+    solve_s = time.perf_counter() - t0
+    lam = np.array(band.lam, dtype=complex)
+    vecs = np.array(band.vecs).T if band.vecs else np.zeros((m.shape[0], 0), complex)
+    keep = sorted((lam[i].imag / TWO_PI, i) for i in range(len(lam))
+                  if abs(lam[i].imag) > REAL_ROOT_REL * abs(lam[i])
+                  and fmin * (1 - 1e-12) <= lam[i].imag / TWO_PI <= fmax * (1 + 1e-12))
+    idx = [i for _, i in keep]
+    lam, vecs = lam[idx], vecs[:, idx]
+    eta = backward_errors(m, k, lam, vecs) if len(lam) else np.zeros(0)
+    return lam, eta, solve_s, band
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--ordering", choices=sorted(ORDERINGS), default="auto",
+                    help="MUMPS fill-reducing ordering (see ORDERINGS); default auto")
+    args, sq, fmin, fmax = parse_args(ap, "slepc.json")
+
+    t0 = time.perf_counter()
+    m, k = load_operator(args.operator, args.mu)
+    load_s = time.perf_counter() - t0
+    version = ".".join(str(v) for v in SLEPc.Sys.getVersion())
+    petsc_version = ".".join(str(v) for v in PETSc.Sys.getVersion())
+    print(f"SLEPc {version}, PETSc {petsc_version}: operator n = {m.shape[0]}, "
+          f"nnz(M~) = {m.nnz}, nnz(K~) = {k.nnz}, read in {load_s:.2f}s", file=sys.stderr)
+    lam, eta, solve_s, band = solve_band(m, k, fmin, fmax, args.tol, args.ordering)
+    lu = PETSc.Log.Event("MatLUFactorNum").getPerfInfo()
+    band.factorizations = int(lu["count"])
+    settings = (f"EPS krylovschur GNHEP in s = -lambda^2, ST sinvert, KSP preonly, "
+                f"PC lu MUMPS ordering {args.ordering} (used: {band.ordering_used}), "
+                f"tol {args.tol:g} (EPS_CONV_REL), squeal's windows and nev doubling")
+    report = {
+        "solver": f"SLEPc {version} / PETSc {petsc_version}", "settings": settings,
+        "setup_s": band.setup_s, "factor_numeric_s": lu["time"],
+        "factor_entries": band.factor_entries,
+    }
+    extra = [("  of which factorization (s)", "", f"{band.setup_s:.2f}"),
+             ("entries in the factors", "", f"{band.factor_entries:,}")]
+    write_and_compare("SLEPc", "SLEPc", args, (fmin, fmax), m.shape[0], lam, eta, solve_s,
+                      load_s, band, report, sq, extra, args.out or (args.operator / "slepc.json"))
+
+if __name__ == "__main__":
+    main()
