@@ -14,7 +14,8 @@ use squeal::analysis::bench::{bench_case, BenchOptions};
 use squeal::core::{EigenParams, Params};
 use squeal_io::ParametricOperator;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// Runs the example (public so that `tests/examples.rs` runs it too).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     let reg = squeal::registry();
     let dir = concat!(
         env!("CARGO_MANIFEST_DIR"),

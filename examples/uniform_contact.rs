@@ -17,7 +17,8 @@ use squeal::analysis::pipeline::{Method, Prepared};
 use squeal::core::{EigenParams, Params};
 use squeal::scene::Scene;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// Runs the example (public so that `tests/examples.rs` runs it too).
+pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     let reg = squeal::registry();
     let name = "pin-on-disc-coarse";
     let prep = Prepared::new(&reg, Scene::builtin(name)?, name)?;
