@@ -134,39 +134,52 @@ class Band:
             print(f"  scipy window [{lo:.0f}, {hi:.0f}] Hz: k = {nev}, {count[0]} OP applications",
                   file=sys.stderr)
         lam = 1j * np.sqrt(s.astype(complex))  # principal root: Im(lambda) >= 0
-        slack = 1e-8 * hi
-        before = len(self.lam)
-        matched = [False] * before
-        for j, l in enumerate(lam):
-            if not np.isfinite(l) or l.imag <= 0.0:
-                continue
-            f = l.imag / TWO_PI
-            if f < lo - slack or f > hi + slack:
-                continue
-            tol = max(1e-8 * abs(l), 100.0 * self.tol * abs(l))
-            dup = next((p for p in range(before)
-                        if not matched[p] and abs(self.lam[p] - l) <= tol), None)
-            if dup is not None:
-                matched[dup] = True
-                continue
-            self.lam.append(l)
-            self.vecs.append(z[:, j])
+        keep_new(self, lo, hi, ((l, lambda j=j: z[:, j]) for j, l in enumerate(lam)))
+
+
+def keep_new(band, lo, hi, pairs):
+    """Appends to `band.lam` and `band.vecs` the pairs `(lambda, vector getter)` of the
+    window [lo, hi] Hz that lie in it (Im(lambda) > 0) and that no earlier window found
+    (one earlier match per pair, to max(1e-8, 100 tol) relative)."""
+    slack = 1e-8 * hi
+    before = len(band.lam)
+    matched = [False] * before
+    for l, vector in pairs:
+        if not np.isfinite(l) or l.imag <= 0.0:
+            continue
+        f = l.imag / TWO_PI
+        if f < lo - slack or f > hi + slack:
+            continue
+        tol = max(1e-8 * abs(l), 100.0 * band.tol * abs(l))
+        dup = next((p for p in range(before)
+                    if not matched[p] and abs(band.lam[p] - l) <= tol), None)
+        if dup is not None:
+            matched[dup] = True
+            continue
+        band.lam.append(l)
+        band.vecs.append(vector())
+
+
+def band_modes(band, m, k, fmin, fmax):
+    """The modes `band` found in [fmin, fmax] Hz by frequency, real roots left out, with
+    their backward errors: `(lambda, eta)`."""
+    lam = np.array(band.lam, dtype=complex)
+    vecs = np.array(band.vecs).T if band.vecs else np.zeros((m.shape[0], 0), complex)
+    keep = sorted((lam[i].imag / TWO_PI, i) for i in range(len(lam))
+                  if abs(lam[i].imag) > REAL_ROOT_REL * abs(lam[i])
+                  and fmin * (1 - 1e-12) <= lam[i].imag / TWO_PI <= fmax * (1 + 1e-12))
+    idx = [i for _, i in keep]
+    lam, vecs = lam[idx], vecs[:, idx]
+    eta = backward_errors(m, k, lam, vecs) if len(lam) else np.zeros(0)
+    return lam, eta
 
 
 def solve_band(m, k, fmin, fmax, tol):
     band = Band(m, k, tol)
     t0 = time.perf_counter()
     band.window(fmin, fmax, 0, band.nev0)
-    lam = np.array(band.lam, dtype=complex)
-    vecs = np.array(band.vecs).T if band.vecs else np.zeros((m.shape[0], 0), complex)
-    keep = [(lam[i].imag / TWO_PI, i) for i in range(len(lam))
-            if abs(lam[i].imag) > REAL_ROOT_REL * abs(lam[i])
-            and fmin * (1 - 1e-12) <= lam[i].imag / TWO_PI <= fmax * (1 + 1e-12)]
-    keep.sort()
-    idx = [i for _, i in keep]
-    lam, vecs = lam[idx], vecs[:, idx]
     solve_s = time.perf_counter() - t0
-    eta = backward_errors(m, k, lam, vecs) if len(lam) else np.zeros(0)
+    lam, eta = band_modes(band, m, k, fmin, fmax)
     return lam, eta, solve_s, band
 
 

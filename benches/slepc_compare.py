@@ -30,8 +30,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from scipy_compare import (REAL_ROOT_REL, TWO_PI, backward_errors,  # noqa: E402
-                           load_operator, parse_args, write_and_compare)
+from scipy_compare import (TWO_PI, band_modes, keep_new, load_operator,  # noqa: E402
+                           parse_args, write_and_compare)
 
 import petsc4py  # noqa: E402
 
@@ -145,25 +145,15 @@ class SlepcBand:
         print(f"  slepc window [{lo:.0f}, {hi:.0f}] Hz: nev = {nev}, {nconv} converged, "
               f"{its} restarts", file=sys.stderr)
         vr, vi = self.pk.createVecs()
-        slack = 1e-8 * hi
-        before = len(self.lam)
-        matched = [False] * before
-        for j in range(nconv):
-            sj = e.getEigenpair(j, vr, vi)
-            lam = 1j * np.sqrt(complex(sj))  # principal root: Im(lambda) >= 0
-            if not np.isfinite(lam) or lam.imag <= 0.0:
-                continue
-            f = lam.imag / TWO_PI
-            if f < lo - slack or f > hi + slack:
-                continue
-            tol = max(1e-8 * abs(lam), 100.0 * self.tol * abs(lam))
-            dup = next((p for p in range(before)
-                        if not matched[p] and abs(self.lam[p] - lam) <= tol), None)
-            if dup is not None:
-                matched[dup] = True
-                continue
-            self.lam.append(lam)
-            self.vecs.append(vr.getArray().copy() + 1j * vi.getArray().copy())
+
+        def pairs():
+            for j in range(nconv):
+                sj = e.getEigenpair(j, vr, vi)
+                # principal root: Im(lambda) >= 0; the vector is read before the next pair
+                vector = vr.getArray().copy() + 1j * vi.getArray().copy()
+                yield 1j * np.sqrt(complex(sj)), lambda v=vector: v
+
+        keep_new(self, lo, hi, pairs())
         e.destroy()
 
 
@@ -172,14 +162,7 @@ def solve_band(m, k, fmin, fmax, tol, ordering):
     t0 = time.perf_counter()
     band.window(fmin, fmax, 0, band.nev0)
     solve_s = time.perf_counter() - t0
-    lam = np.array(band.lam, dtype=complex)
-    vecs = np.array(band.vecs).T if band.vecs else np.zeros((m.shape[0], 0), complex)
-    keep = sorted((lam[i].imag / TWO_PI, i) for i in range(len(lam))
-                  if abs(lam[i].imag) > REAL_ROOT_REL * abs(lam[i])
-                  and fmin * (1 - 1e-12) <= lam[i].imag / TWO_PI <= fmax * (1 + 1e-12))
-    idx = [i for _, i in keep]
-    lam, vecs = lam[idx], vecs[:, idx]
-    eta = backward_errors(m, k, lam, vecs) if len(lam) else np.zeros(0)
+    lam, eta = band_modes(band, m, k, fmin, fmax)
     return lam, eta, solve_s, band
 
 

@@ -9,7 +9,8 @@ pub(super) fn imported(
     imp: &crate::MeshImport,
     im: &crate::ImportedMesh,
 ) -> Result<()> {
-    let (scene, registry, file) = (asm.scene, asm.registry, asm.file);
+    let cx = asm.cx;
+    let scene = cx.scene;
     let rule = &scene.mesh;
     let Assembly {
         mesh,
@@ -19,11 +20,8 @@ pub(super) fn imported(
         fixed_nodes,
         ..
     } = asm;
-    let mat = |spec: &crate::MaterialSpec, field: &str| material(registry, file, spec, field);
-    let missing = |field: &str| missing_table(file, field);
-    let group_field = |body: &str, f: &str, m: String| group_error(file, body, f, m);
-    let d = scene.disc.as_ref().ok_or_else(|| missing("disc"))?;
-    let m = mat(&d.material, "disc.material")?;
+    let d = scene.disc.as_ref().ok_or_else(|| cx.missing("disc"))?;
+    let m = cx.material(&d.material, "disc.material")?;
     let (lambda, h) = element_size(
         m.as_ref(),
         d.thickness_m,
@@ -38,7 +36,7 @@ pub(super) fn imported(
         materials.len(),
         "disc.",
     )
-    .map_err(|msg| group_field("disc", "fixed_groups", msg))?;
+    .map_err(|msg| cx.group_error("disc", "fixed_groups", msg))?;
     // the rule's target size, for comparison with the imported elements
     sizes.push(SizeRule {
         body: "disc".into(),
@@ -55,7 +53,8 @@ pub(super) fn imported(
 /// when there is a pin), its hat and flange when the scene has them, and the disc's
 /// contact layer under a refined contact grid.
 pub(super) fn generated(asm: &mut Assembly<'_>, lay: &Layout) -> Result<()> {
-    let (scene, registry, file) = (asm.scene, asm.registry, asm.file);
+    let cx = asm.cx;
+    let (scene, file) = (cx.scene, cx.file);
     let rule = &scene.mesh;
     let Assembly {
         mesh,
@@ -73,16 +72,12 @@ pub(super) fn generated(asm: &mut Assembly<'_>, lay: &Layout) -> Result<()> {
         pin_import,
         ..
     } = lay;
-    let mat = |spec: &crate::MaterialSpec, field: &str| material(registry, file, spec, field);
-    let missing = |field: &str| missing_table(file, field);
-    let group_field = |body: &str, f: &str, m: String| group_error(file, body, f, m);
-    let tie_error = |m: String| refinement_error(file, m);
-    let d = scene.disc.as_ref().ok_or_else(|| missing("disc"))?;
-    let m = mat(&d.material, "disc.material")?;
+    let d = scene.disc.as_ref().ok_or_else(|| cx.missing("disc"))?;
+    let m = cx.material(&d.material, "disc.material")?;
     if let (Some(pa), Some((_, im))) = (&patch, &pin_import) {
         let (x0, x1) = (pa.xs[0], pa.xs[pa.xs.len() - 1]);
         if (x0 + x1).abs() > 1e-9 * (x1 - x0) {
-            return Err(group_field(
+            return Err(cx.group_error(
                 "pin",
                 "contact_group",
                 format!(
@@ -148,8 +143,8 @@ pub(super) fn generated(asm: &mut Assembly<'_>, lay: &Layout) -> Result<()> {
         // tied to the ring's patch grid
         budget.take("disc contact layer", &[fp.xs.len(), fp.ys.len(), 2], file)?;
         let layer = Mesh::block(&fp.xs, &fp.ys, &[0.0, *t]).with_body(body);
-        let (layer_ties, rule) =
-            contact_layer(mesh, &layer, "disc", "zmin", "zmax", pa, fp, 1).map_err(tie_error)?;
+        let (layer_ties, rule) = contact_layer(mesh, &layer, "disc", "zmin", "zmax", pa, fp, 1)
+            .map_err(|m| cx.refinement_error(m))?;
         ties.extend(layer_ties);
         sizes.push(rule);
     }

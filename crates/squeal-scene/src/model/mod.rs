@@ -140,9 +140,7 @@ impl Model {
 
 /// The model being built: the mesh so far and what each body added.
 struct Assembly<'a> {
-    scene: &'a Scene,
-    registry: &'a Registry,
-    file: &'a str,
+    cx: Context<'a>,
     mesh: Mesh,
     budget: NodeBudget,
     materials: Vec<Box<dyn Material>>,
@@ -167,53 +165,58 @@ struct Layout {
     lift: f64,
 }
 
-/// The material of the table `field` from its spec.
-fn material(
-    registry: &Registry,
-    file: &str,
-    spec: &crate::MaterialSpec,
-    field: &str,
-) -> Result<Box<dyn Material>> {
-    let params = spec.params(file, field)?;
-    registry
-        .materials
-        .create(&spec.kind, &params)
-        .map_err(|source| SceneError::Core {
-            file: file.into(),
-            context: field.into(),
-            source: Box::new(source),
-        })
+/// What every body builder reads: the scene, the plugins, and the file name of errors.
+#[derive(Clone, Copy)]
+struct Context<'a> {
+    scene: &'a Scene,
+    registry: &'a Registry,
+    file: &'a str,
 }
 
-/// A body asked for whose table the scene does not have.
-fn missing_table(file: &str, field: &str) -> SceneError {
-    SceneError::Field {
-        file: file.into(),
-        field: field.into(),
-        message: "this body is asked for but the scene has no such table".into(),
+impl Context<'_> {
+    /// The material of the table `field` from its spec.
+    fn material(&self, spec: &crate::MaterialSpec, field: &str) -> Result<Box<dyn Material>> {
+        let params = spec.params(self.file, field)?;
+        self.registry
+            .materials
+            .create(&spec.kind, &params)
+            .map_err(|source| SceneError::Core {
+                file: self.file.into(),
+                context: field.into(),
+                source: Box::new(source),
+            })
+    }
+
+    /// A body asked for whose table the scene does not have.
+    fn missing(&self, field: &str) -> SceneError {
+        self.field_error(
+            field.into(),
+            "this body is asked for but the scene has no such table",
+        )
+    }
+
+    /// An error of the field `f` of `{body}.mesh`.
+    fn group_error(&self, body: &str, f: &str, message: String) -> SceneError {
+        self.field_error(format!("{body}.mesh.{f}"), message)
+    }
+
+    /// An error of the contact refinement (its layers and ties).
+    fn refinement_error(&self, message: String) -> SceneError {
+        self.field_error("mesh.contact_refinement".into(), message)
+    }
+
+    fn field_error(&self, field: String, message: impl Into<String>) -> SceneError {
+        SceneError::Field {
+            file: self.file.into(),
+            field,
+            message: message.into(),
+        }
     }
 }
 
-/// An error of the field `f` of `{body}.mesh`.
-fn group_error(file: &str, body: &str, f: &str, message: String) -> SceneError {
-    SceneError::Field {
-        file: file.into(),
-        field: format!("{body}.mesh.{f}"),
-        message,
-    }
-}
-
-/// An error of the contact refinement (its layers and ties).
-fn refinement_error(file: &str, message: String) -> SceneError {
-    SceneError::Field {
-        file: file.into(),
-        field: "mesh.contact_refinement".into(),
-        message,
-    }
-}
-
-/// The imported meshes, the contact patch and its refinement of `scene`.
-fn layout(scene: &Scene, file: &str) -> Result<Layout> {
+/// The imported meshes, the contact patch and its refinement of the scene.
+fn layout(cx: Context<'_>) -> Result<Layout> {
+    let (scene, file) = (cx.scene, cx.file);
     let rule = &scene.mesh;
     // Imported meshes: read by Scene::from_file, else now (relative to the working
     // directory).
@@ -236,13 +239,12 @@ fn layout(scene: &Scene, file: &str) -> Result<Layout> {
         "disc.mesh",
     )?;
     let pin_import = import(scene.pin.as_ref().and_then(|p| p.mesh.as_ref()), "pin.mesh")?;
-    let group_field = |body: &str, f: &str, m: String| group_error(file, body, f, m);
     // The contact patch under the pin: a Cartesian grid blended into the polar disc; the
     // grid lines of an imported pin's contact group when the scene has a disc.
     let patch = match (&scene.pin, &pin_import) {
         (Some(_), Some((imp, im))) if scene.disc.is_some() => {
             let g = imp.contact_group.as_deref().ok_or_else(|| {
-                group_field(
+                cx.group_error(
                     "pin",
                     "contact_group",
                     "expected the pin face's group".into(),
@@ -251,9 +253,9 @@ fn layout(scene: &Scene, file: &str) -> Result<Layout> {
             let set = im
                 .mesh
                 .node_set(g)
-                .map_err(|m| group_field("pin", "contact_group", m))?;
+                .map_err(|m| cx.group_error("pin", "contact_group", m))?;
             let (xs, ys) = face_grid(&im.mesh, set).map_err(|m| {
-                group_field(
+                cx.group_error(
                     "pin",
                     "contact_group",
                     format!("group `{g}` of {}: {m}", im.path.display()),
@@ -286,11 +288,14 @@ fn layout(scene: &Scene, file: &str) -> Result<Layout> {
 /// `file` names the scene in errors.
 pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) -> Result<Model> {
     let start = Instant::now();
-    let lay = layout(scene, file)?;
-    let mut asm = Assembly {
+    let cx = Context {
         scene,
         registry,
         file,
+    };
+    let lay = layout(cx)?;
+    let mut asm = Assembly {
+        cx,
         mesh: Mesh::default(),
         budget: NodeBudget::new(scene.mesh.max_dofs),
         materials: Vec::new(),
@@ -324,7 +329,7 @@ pub fn build(scene: &Scene, which: BodyKind, registry: &Registry, file: &str) ->
     fixed_nodes.sort_unstable();
     fixed_nodes.dedup();
     let dofs = DofMap::with_ties(&mesh, &DofMap::node_dofs(&fixed_nodes), &ties)
-        .map_err(|m| refinement_error(file, m))?;
+        .map_err(|m| cx.refinement_error(m))?;
     let refs: Vec<&dyn Material> = materials.iter().map(|m| m.as_ref()).collect();
     let asm = assemble(&mesh, &dofs, &refs).map_err(|source| SceneError::Core {
         file: file.into(),

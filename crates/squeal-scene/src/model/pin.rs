@@ -10,7 +10,8 @@ pub(super) fn imported(
     im: &crate::ImportedMesh,
     lay: &Layout,
 ) -> Result<()> {
-    let (scene, registry, file) = (asm.scene, asm.registry, asm.file);
+    let cx = asm.cx;
+    let scene = cx.scene;
     let Assembly {
         mesh,
         materials,
@@ -20,11 +21,8 @@ pub(super) fn imported(
         ..
     } = asm;
     let Layout { patch, .. } = lay;
-    let mat = |spec: &crate::MaterialSpec, field: &str| material(registry, file, spec, field);
-    let missing = |field: &str| missing_table(file, field);
-    let group_field = |body: &str, f: &str, m: String| group_error(file, body, f, m);
-    let p = scene.pin.as_ref().ok_or_else(|| missing("pin"))?;
-    let pin_mat = mat(&p.material, "pin.material")?;
+    let p = scene.pin.as_ref().ok_or_else(|| cx.missing("pin"))?;
+    let pin_mat = cx.material(&p.material, "pin.material")?;
     append_imported(
         mesh,
         fixed_nodes,
@@ -33,7 +31,7 @@ pub(super) fn imported(
         materials.len(),
         "pin.",
     )
-    .map_err(|msg| group_field("pin", "fixed_groups", msg))?;
+    .map_err(|msg| cx.group_error("pin", "fixed_groups", msg))?;
     let face = patch.as_ref().filter(|_| scene.disc.is_some());
     sizes.push(SizeRule {
         body: "pin".into(),
@@ -50,7 +48,8 @@ pub(super) fn imported(
 /// layer the fine contact layer under a refined contact grid), then the thin and thick
 /// plates stacked on it, on grid lines that contain the pin face's.
 pub(super) fn generated(asm: &mut Assembly<'_>, lay: &Layout) -> Result<()> {
-    let (scene, registry, file) = (asm.scene, asm.registry, asm.file);
+    let cx = asm.cx;
+    let (scene, file) = (cx.scene, cx.file);
     let rule = &scene.mesh;
     let Assembly {
         mesh,
@@ -66,11 +65,8 @@ pub(super) fn generated(asm: &mut Assembly<'_>, lay: &Layout) -> Result<()> {
         patch, fine, lift, ..
     } = lay;
     let lift = *lift;
-    let mat = |spec: &crate::MaterialSpec, field: &str| material(registry, file, spec, field);
-    let missing = |field: &str| missing_table(file, field);
-    let tie_error = |m: String| refinement_error(file, m);
-    let p = scene.pin.as_ref().ok_or_else(|| missing("pin"))?;
-    let pin_mat = mat(&p.material, "pin.material")?;
+    let p = scene.pin.as_ref().ok_or_else(|| cx.missing("pin"))?;
+    let pin_mat = cx.material(&p.material, "pin.material")?;
     let (a, b, yc) = (p.size_x_m, p.size_y_m, p.center_radius_m);
     let face = rule.pin_face_elements as f64;
     let h_pin = a.min(b) / face;
@@ -84,7 +80,7 @@ pub(super) fn generated(asm: &mut Assembly<'_>, lay: &Layout) -> Result<()> {
     let mut plate_mats = Vec::new();
     let mut h_plate = f64::INFINITY;
     for (name, pl) in &plates {
-        let m = mat(&pl.material, &format!("{name}.material"))?;
+        let m = cx.material(&pl.material, &format!("{name}.material"))?;
         let (lambda, h) = element_size(
             m.as_ref(),
             pl.thickness_m,
@@ -120,7 +116,7 @@ pub(super) fn generated(asm: &mut Assembly<'_>, lay: &Layout) -> Result<()> {
             // the pin's first layer becomes the fine contact layer, its top tied to
             // the coarse pin above it; everything sits `lift` higher
             if zp.len() < 3 {
-                return Err(tie_error(format!(
+                return Err(cx.refinement_error(format!(
                     "the pin ({} m high) has a single element layer; the contact layer \
                      needs a second one (raise mesh.min_layers)",
                     p.height_m
@@ -143,7 +139,7 @@ pub(super) fn generated(asm: &mut Assembly<'_>, lay: &Layout) -> Result<()> {
             )
             .with_body(materials.len());
             let (layer_ties, rule) = contact_layer(mesh, &layer, "pin", "zmax", "zmin", pa, fp, nl)
-                .map_err(tie_error)?;
+                .map_err(|m| cx.refinement_error(m))?;
             ties.extend(layer_ties);
             sizes.push(rule);
         }

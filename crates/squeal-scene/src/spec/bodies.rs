@@ -175,15 +175,6 @@ pub(super) fn validate_disc(scene: &Scene, file: &str) -> Result<()> {
                 ));
             }
         }
-        if d.inner_radius_m >= d.outer_radius_m {
-            return Err(field(
-                "disc.inner_radius_m",
-                format!(
-                    "expected less than disc.outer_radius_m = {}, got {}",
-                    d.outer_radius_m, d.inner_radius_m
-                ),
-            ));
-        }
     }
     Ok(())
 }
