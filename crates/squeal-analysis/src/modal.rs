@@ -2,10 +2,15 @@
 //! it, pair doublets, and compare the disc with the paper's Table 2.
 
 use crate::labels::{body_shares, label_disc, label_pin, nodal_weights};
+use crate::outdir::RunError;
+use crate::pipeline::PipelineError;
 use crate::reference::paper;
 use serde::Serialize;
-use squeal_core::{EigenParams, EigenSolver, RealModes, Result, SymmetricProblem};
-use squeal_scene::Model;
+use squeal_core::{
+    EigenParams, EigenSolver, Params, RealModes, Registry, Result, SymmetricProblem,
+};
+use squeal_scene::{build, BodyKind, Model, Scene};
+use std::time::Instant;
 
 /// One labelled mode (the `modes` entries of `squeal modes --json`).
 #[derive(Debug, Clone, Serialize)]
@@ -40,6 +45,85 @@ pub fn normal_modes(
     let modes = solver.solve_symmetric(&problem, params)?;
     let records = label_modes(model, &modes);
     Ok((modes, records))
+}
+
+/// The labelled normal modes of some bodies of a scene, as `squeal modes --json` writes
+/// them.
+#[derive(Debug, Clone, Serialize)]
+pub struct BodyModes {
+    /// The scene's name in messages.
+    pub scene: String,
+    /// Units of the numbers.
+    pub units: &'static str,
+    /// Free DOFs of the model.
+    pub dofs: usize,
+    /// Hexahedra of the mesh.
+    pub elements: usize,
+    /// Mass of the model (kg).
+    pub total_mass_kg: f64,
+    /// Eigen solver plugin.
+    pub solver: String,
+    /// Relative tolerance of the solve.
+    pub tol: f64,
+    /// Band top (Hz).
+    pub max_freq_hz: f64,
+    /// Time to build the model (s).
+    pub build_time_s: f64,
+    /// Time of the eigen solve (s).
+    pub solve_time_s: f64,
+    /// Wall time (s).
+    pub time_s: f64,
+    /// The solver's notes.
+    pub notes: Vec<String>,
+    /// The modes, labelled.
+    pub modes: Vec<ModeRecord>,
+}
+
+/// Builds the bodies `which` of `scene` (named `file` in messages) with a free contact
+/// face and solves their normal modes up to `max_freq` Hz with the eigen plugin `eigen`
+/// at tolerance `tol`. Returns the report, the model and the modes (for mode shapes).
+pub fn body_modes(
+    registry: &Registry,
+    scene: &Scene,
+    file: &str,
+    which: BodyKind,
+    max_freq: f64,
+    eigen: &str,
+    tol: f64,
+) -> std::result::Result<(BodyModes, Model, RealModes), RunError> {
+    let start = Instant::now();
+    let model = build(scene, which, registry, file).map_err(PipelineError::from)?;
+    let stage = format!("normal modes of {file} with `{eigen}`");
+    let core = |source| RunError::Stage {
+        stage: stage.clone(),
+        source: Box::new(PipelineError::Core {
+            stage: "eigen solve".into(),
+            source,
+        }),
+    };
+    let solver = registry.eigen.create(eigen, &Params::new()).map_err(core)?;
+    let params = EigenParams {
+        fmax_hz: max_freq,
+        tol,
+        ..EigenParams::default()
+    };
+    let (modes, records) = normal_modes(&model, solver.as_ref(), &params).map_err(core)?;
+    let report = BodyModes {
+        scene: file.to_string(),
+        units: "SI: frequencies in Hz, masses in kg, times in s",
+        dofs: model.dofs.n_free(),
+        elements: model.mesh.hexes.len(),
+        total_mass_kg: model.total_mass,
+        solver: eigen.into(),
+        tol,
+        max_freq_hz: max_freq,
+        build_time_s: model.build_time_s,
+        solve_time_s: modes.info.time_s,
+        time_s: start.elapsed().as_secs_f64(),
+        notes: modes.info.notes.clone(),
+        modes: records,
+    };
+    Ok((report, model, modes))
 }
 
 /// Attributes, labels and pairs the modes of `model`.

@@ -2,66 +2,11 @@
 //! a contact force map.
 
 use anyhow::{Context, Result};
-use serde::Serialize;
+use squeal_analysis::equilibria::EquilibriumReport;
 use squeal_analysis::pipeline::Prepared;
-use squeal_contact::{ContactSet, LoadedEquilibrium};
+use squeal_contact::LoadedEquilibrium;
 use squeal_core::{Params, Registry};
-use std::io::Write;
 use std::path::{Path, PathBuf};
-
-/// One equilibrium as written to `equilibrium.json`.
-#[derive(Serialize, Clone)]
-pub struct EquilibriumReport {
-    pub scene: String,
-    pub units: &'static str,
-    pub solver: String,
-    pub law: String,
-    pub mu: f64,
-    pub total_normal_force_n: f64,
-    pub total_tangential_force_n: f64,
-    pub tangential_resultant_n: [f64; 2],
-    pub disc_displacement_m: f64,
-    pub active_pairs: usize,
-    pub pairs: usize,
-    pub iterations: usize,
-    pub factorizations: usize,
-    pub residual: f64,
-    pub complementarity_residual: f64,
-    pub centroid_m: [f64; 2],
-    pub sliding_direction: [f64; 2],
-    pub leading_edge: String,
-    pub build_time_s: f64,
-    pub condensation_time_s: f64,
-    pub time_s: f64,
-    pub csv: String,
-}
-
-pub fn leading_edge(rotation: f64) -> String {
-    if rotation > 0.0 {
-        "+x: the disc surface moves along -x under the pin and enters it at its +x edge".into()
-    } else {
-        "-x: the disc surface moves along +x under the pin and enters it at its -x edge".into()
-    }
-}
-
-pub fn write_csv(path: &Path, set: &ContactSet, eq: &LoadedEquilibrium) -> Result<()> {
-    let mut f = std::io::BufWriter::new(
-        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?,
-    );
-    writeln!(f, "x_m,y_m,rn_n,rt_n,active")?;
-    for i in 0..set.len() {
-        writeln!(
-            f,
-            "{},{},{},{},{}",
-            crate::num::sci(set.xy[i][0], 9),
-            crate::num::sci(set.xy[i][1], 9),
-            crate::num::sci(eq.eq.rn[i], 9),
-            crate::num::sci(eq.eq.mu * eq.eq.rn[i], 9),
-            u8::from(eq.eq.active[i])
-        )?;
-    }
-    Ok(())
-}
 
 /// `squeal equilibrium`.
 #[derive(clap::Args)]
@@ -125,13 +70,13 @@ impl EquilibriumArgs {
             println!(
                 "{:>6.3} {:>10} {:>10} {:>7} {:>6} {:>10.2e} {:>10.2e} {:>13} {:>8.3}",
                 r.mu,
-                crate::num::fixed(r.total_normal_force_n, 4),
-                crate::num::fixed(r.total_tangential_force_n, 4),
+                squeal_analysis::num::fixed(r.total_normal_force_n, 4),
+                squeal_analysis::num::fixed(r.total_tangential_force_n, 4),
                 r.active_pairs,
                 r.iterations,
                 r.residual,
                 r.complementarity_residual,
-                crate::num::fixed(r.centroid_m[0] * 1e3, 4),
+                squeal_analysis::num::fixed(r.centroid_m[0] * 1e3, 4),
                 r.time_s
             );
         }
@@ -164,76 +109,26 @@ pub fn run(
     };
     let prep = Prepared::new(registry, scene, &file)?;
     crate::opts::claim_out(out, "equilibrium")?;
-    run_on(registry, &prep, &mus, solver, law, law_params, out)
+    let (reports, eqs) =
+        squeal_analysis::equilibria::run_into(registry, &prep, &mus, solver, law, law_params, out)?;
+    contact_map(out, &prep, &eqs, solver, law)?;
+    Ok(reports)
 }
 
-/// The equilibria of a prepared scene at `mus`, written into `out` (shared with
-/// `validate`).
-pub fn run_on(
-    registry: &Registry,
+/// Draws the normal force of every pair of each equilibrium (`contact_map.svg/png`).
+pub fn contact_map(
+    out: &Path,
     prep: &Prepared,
-    mus: &[f64],
+    eqs: &[LoadedEquilibrium],
     solver: &str,
     law: &str,
-    law_params: &Params,
-    out: &Path,
-) -> Result<Vec<EquilibriumReport>> {
-    let mut eqs = Vec::new();
-    for &mu in mus {
-        eqs.push(
-            prep.equilibrium_with(registry, solver, law, law_params, mu)
-                .with_context(|| format!("equilibrium at mu = {mu} with `{solver}`"))?,
-        );
-    }
-    let cond_time = prep.condensation.time_s;
-    crate::opts::prepare_out(out)?;
-    let mut reports = Vec::new();
-    let c = prep.set.len() / 2;
-    let dir = prep.set.direction[c];
-    for eq in &eqs {
-        let csv = if eqs.len() == 1 {
-            "pairs.csv".to_string()
-        } else {
-            format!("pairs_mu{:.3}.csv", eq.eq.mu)
-        };
-        write_csv(&out.join(&csv), &prep.set, eq)?;
-        reports.push(EquilibriumReport {
-            scene: prep.file.clone(),
-            units: "SI: forces in N, lengths in m, times in s",
-            solver: solver.into(),
-            law: law.into(),
-            mu: eq.eq.mu,
-            total_normal_force_n: eq.total_normal_force_n,
-            total_tangential_force_n: eq.total_tangential_force_n,
-            tangential_resultant_n: eq.tangential_resultant_n,
-            disc_displacement_m: eq.displacement_m,
-            active_pairs: eq.eq.active.iter().filter(|&&a| a).count(),
-            pairs: prep.set.len(),
-            iterations: eq.eq.iterations,
-            factorizations: 1,
-            residual: eq.eq.equilibrium_residual,
-            complementarity_residual: eq.eq.complementarity_residual,
-            centroid_m: eq.centroid_m,
-            sliding_direction: [dir[0], dir[1]],
-            leading_edge: leading_edge(prep.set.rotation),
-            build_time_s: prep.build_time_s,
-            condensation_time_s: cond_time,
-            time_s: eq.eq.time_s,
-            csv,
-        });
-    }
-    let json = if reports.len() == 1 {
-        serde_json::to_string_pretty(&reports[0])?
-    } else {
-        serde_json::to_string_pretty(&reports)?
-    };
-    let path = out.join("equilibrium.json");
-    std::fs::write(&path, json).with_context(|| format!("writing {}", path.display()))?;
+) -> Result<()> {
     let grid = prep
         .model
         .contact
         .as_ref()
         .expect("a contact set has a grid");
+    let dir = prep.set.direction[prep.set.len() / 2];
     let cell = [grid.xs[1] - grid.xs[0], grid.ys[1] - grid.ys[0]];
     let grid_cells = grid.cells();
     let cells: Vec<[f64; 4]> = prep.set.grid_index.iter().map(|&g| grid_cells[g]).collect();
@@ -267,7 +162,7 @@ pub fn run_on(
         &panels,
     )
     .context("contact force map")?;
-    Ok(reports)
+    Ok(())
 }
 
 /// Output paths written by [`run`] besides the charts.

@@ -6,7 +6,6 @@ mod bench;
 mod calibrate;
 mod equilibrium;
 mod modes;
-mod num;
 mod opts;
 mod scene_cmd;
 mod stability;

@@ -1,12 +1,10 @@
 //! `squeal modes`: build, solve, label, print and write JSON.
 
 use anyhow::{Context, Result};
-use serde::Serialize;
-use squeal_analysis::modal::{normal_modes, ModeRecord};
-use squeal_core::{EigenParams, Params, Registry};
-use squeal_scene::{build, BodyKind};
+use squeal_analysis::modal::{body_modes, BodyModes};
+use squeal_core::Registry;
+use squeal_scene::BodyKind;
 use std::path::PathBuf;
-use std::time::Instant;
 
 /// Bodies of a scene.
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -70,22 +68,7 @@ impl ModesArgs {
 }
 
 /// What `squeal modes --json` writes.
-#[derive(Serialize)]
-pub struct ModesReport {
-    pub scene: String,
-    pub units: &'static str,
-    pub dofs: usize,
-    pub elements: usize,
-    pub total_mass_kg: f64,
-    pub solver: String,
-    pub tol: f64,
-    pub max_freq_hz: f64,
-    pub build_time_s: f64,
-    pub solve_time_s: f64,
-    pub time_s: f64,
-    pub notes: Vec<String>,
-    pub modes: Vec<ModeRecord>,
-}
+pub type ModesReport = BodyModes;
 
 pub fn run(
     registry: &Registry,
@@ -97,32 +80,7 @@ pub fn run(
     vtu: Option<&std::path::Path>,
 ) -> Result<ModesReport> {
     let (scene, file) = crate::opts::load_scene(scene)?;
-    run_scene(registry, &scene, &file, which, max_freq, eigen, tol, vtu)
-}
-
-/// [`run`] on a scene already read (`file` names it).
-#[allow(clippy::too_many_arguments)]
-pub fn run_scene(
-    registry: &Registry,
-    scene: &squeal_scene::Scene,
-    file: &str,
-    which: BodyKind,
-    max_freq: f64,
-    eigen: &str,
-    tol: f64,
-    vtu: Option<&std::path::Path>,
-) -> Result<ModesReport> {
-    let start = Instant::now();
-    let file = file.to_string();
-    let model = build(scene, which, registry, &file)?;
-    let solver = registry.eigen.create(eigen, &Params::new())?;
-    let params = EigenParams {
-        fmax_hz: max_freq,
-        tol,
-        ..EigenParams::default()
-    };
-    let (modes, records) = normal_modes(&model, solver.as_ref(), &params)
-        .with_context(|| format!("normal modes of {file} with `{eigen}`"))?;
+    let (report, model, modes) = body_modes(registry, &scene, &file, which, max_freq, eigen, tol)?;
     if let Some(dir) = vtu {
         let shapes: Vec<(f64, Vec<f64>)> = (0..modes.freq_hz.len())
             .map(|i| {
@@ -141,21 +99,7 @@ pub fn run_scene(
             dir.join("modes.pvd").display()
         );
     }
-    Ok(ModesReport {
-        scene: file,
-        units: "SI: frequencies in Hz, masses in kg, times in s",
-        dofs: model.dofs.n_free(),
-        elements: model.mesh.hexes.len(),
-        total_mass_kg: model.total_mass,
-        solver: eigen.into(),
-        tol,
-        max_freq_hz: max_freq,
-        build_time_s: model.build_time_s,
-        solve_time_s: modes.info.time_s,
-        time_s: start.elapsed().as_secs_f64(),
-        notes: modes.info.notes.clone(),
-        modes: records,
-    })
+    Ok(report)
 }
 
 pub fn format(r: &ModesReport) -> String {

@@ -98,13 +98,12 @@ pub fn parse_params(opts: &[String]) -> Result<squeal_core::Params> {
     Ok(p)
 }
 
-/// Creates the output directory `out` (and its parents); refuses a path that is a file.
-pub fn prepare_out(out: &Path) -> Result<()> {
-    if out.exists() && !out.is_dir() {
-        anyhow::bail!("--out {}: is a file, expected a directory", out.display());
+/// A library error about an output directory as the CLI names it: `--out DIR: ...`.
+pub fn out_error(e: squeal_analysis::outdir::RunError) -> anyhow::Error {
+    match e {
+        squeal_analysis::outdir::RunError::Dir { .. } => anyhow::anyhow!("--out {e}"),
+        e => e.into(),
     }
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("--out {}: cannot create the directory", out.display()))
 }
 
 /// The band every command uses unless told otherwise: the scene's `study.band_hz`, or
@@ -287,45 +286,10 @@ pub fn duration(s: f64) -> String {
     }
 }
 
-/// The file that names which command wrote an output directory.
-pub const OUTPUT_MARKER: &str = "squeal-output.json";
-
 /// Claims `out` for `command`: creates it and records the command there; refuses a
-/// directory another command wrote (its marker, or a study's `study.json` / a mu
-/// sweep's `sweep.partial.jsonl` from before markers existed).
+/// directory another command wrote ([`squeal_analysis::outdir::claim`]).
 pub fn claim_out(out: &Path, command: &str) -> Result<()> {
-    prepare_out(out)?;
-    let marker = out.join(OUTPUT_MARKER);
-    let owner = if marker.is_file() {
-        let text = std::fs::read_to_string(&marker)
-            .with_context(|| format!("--out {}: cannot read {OUTPUT_MARKER}", out.display()))?;
-        serde_json::from_str::<serde_json::Value>(&text)
-            .ok()
-            .and_then(|v| v["command"].as_str().map(str::to_string))
-    } else if out.join("study.json").is_file() {
-        Some("sweep macro/meso".into())
-    } else if out.join("sweep.partial.jsonl").is_file() {
-        Some("sweep mu".into())
-    } else {
-        None
-    };
-    match owner {
-        Some(o)
-            if o != command
-                && !(o == "sweep macro/meso"
-                    && command.starts_with("sweep m")
-                    && command != "sweep mu") =>
-        {
-            anyhow::bail!(
-                "--out {}: holds the output of `squeal {o}`; choose another directory for `squeal {command}`",
-                out.display()
-            )
-        }
-        _ => {}
-    }
-    let v = serde_json::json!({ "command": command, "squeal": env!("CARGO_PKG_VERSION") });
-    std::fs::write(&marker, serde_json::to_string_pretty(&v)? + "\n")
-        .with_context(|| format!("--out {}: cannot write {OUTPUT_MARKER}", out.display()))
+    squeal_analysis::outdir::claim(out, command).map_err(out_error)
 }
 
 /// Checks a friction coefficient given as option `flag`.

@@ -321,7 +321,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
         factorizations: modes.info.factorizations,
         notes: modes.info.notes.clone(),
         max_backward_error: modes.backward_error.iter().fold(0.0, |m: f64, &b| m.max(b)),
-        max_error_bound: worst(&modes.error_bound),
+        max_error_bound: squeal_analysis::sweep::files::worst(&modes.error_bound),
         modes: out,
     })
 }
@@ -361,8 +361,8 @@ pub fn print(r: &StabilityReport) {
             "{:>4} {:>12.3} {:>14} {:>12} {:>9} {:>10.1e} {:>10} {:>10}",
             i + 1,
             m.freq_hz,
-            crate::num::sci(m.re, 6),
-            crate::num::sci(m.dvr, 4),
+            squeal_analysis::num::sci(m.re, 6),
+            squeal_analysis::num::sci(m.dvr, 4),
             if m.unstable { "YES" } else { "" },
             m.backward_error,
             sci(m.cond),
@@ -386,13 +386,6 @@ pub fn sci(x: f64) -> String {
     } else {
         format!("{x:.1e}")
     }
-}
-
-/// The largest of `values` that are not NaN (NaN when all are, or there are none).
-pub fn worst(values: &[f64]) -> f64 {
-    values
-        .iter()
-        .fold(f64::NAN, |m, &v| if v.is_nan() || m >= v { m } else { v })
 }
 
 /// Reads an operator directory in either form: the constrained parts (`Mc.mtx`, ...),

@@ -2,19 +2,18 @@
 //! detection, CSV/JSON outputs and the paper's Figure 5 and 7 charts; `squeal sweep
 //! param`: the same for the parameter of a parametric operator directory.
 
-use anyhow::{Context, Result};
-use serde::Serialize;
-use squeal_analysis::family::{reference_modes, run_family_sweep, Parametric, SweepCoupling};
+use anyhow::Result;
+use squeal_analysis::family::SweepCoupling;
 use squeal_analysis::mu_sweep::{
-    mu_list, run_sweep, value_list, CouplingReport, MuSweep, MuSweepSettings,
+    mu_list, run_into, value_list, MuSweep, MuSweepSettings, SweepEvent, SweepSummary,
 };
-use squeal_analysis::pipeline::{FreeModes, Method, Prepared};
-use squeal_analysis::profile::{peak_rss_mb, Profile, StageTime};
-use squeal_analysis::sweep::{Branch, Checkpoint, SweepPoint};
-use squeal_core::{EigenParams, Registry};
-use std::io::Write;
+use squeal_analysis::outdir::RunError;
+use squeal_analysis::param_sweep::ParamSweepSettings;
+use squeal_analysis::pipeline::Prepared;
+use squeal_analysis::profile::Profile;
+use squeal_analysis::sweep::{Branch, SweepPoint};
+use squeal_core::Registry;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// `squeal sweep`: the parameter sweeps.
 #[derive(clap::Subcommand)]
@@ -179,194 +178,88 @@ pub struct ParamArgs {
     out: PathBuf,
 }
 
-/// `summary.json` of `squeal sweep param`.
-#[derive(Serialize)]
-pub struct ParamSummary {
-    pub operator: String,
-    pub units: &'static str,
-    /// The swept parameter's name.
-    pub parameter: String,
-    /// `[from, to, step]` as given.
-    pub range: [f64; 3],
-    pub mu: f64,
-    pub band_hz: [f64; 2],
-    pub eigen: String,
-    pub basis: String,
-    pub dofs: usize,
-    pub dvr_tol: f64,
-    pub points: usize,
-    pub max_basis_size: usize,
-    pub max_backward_error: f64,
-    /// Worst `error_bound` of every point's modes (null: not computed).
-    pub max_error_bound: f64,
-    /// What the signatures of tracking are taken on.
-    pub reference: String,
-    pub reference_modes: usize,
-    pub time_s: f64,
-    /// Couplings: frequency at the largest DvR, first and last unstable value, largest
-    /// DvR, branches, and the reference modes the unstable mode is made of.
-    pub couplings: Vec<SweepCoupling>,
-}
-
 impl ParamArgs {
     /// Checks every option, runs the sweep and prints its couplings.
     pub fn run(&self, registry: &Registry) -> Result<()> {
-        let start = Instant::now();
         self.method.check(registry)?;
-        let values = value_list(self.from, self.to, self.step)
+        value_list(self.from, self.to, self.step)
             .map_err(|e| anyhow::anyhow!("--from/--to/--step: {e}"))?;
         if let Some(mu) = self.mu {
             crate::opts::check_mu("--mu", mu)?;
         }
-        let band = self.method.band(crate::opts::OPERATOR_BAND_HZ)?;
-        let name = self.param.as_str();
-        let flag = format!("--param {name}");
-        let dir = &self.operator;
-        let family_op = crate::opts::read_parametric(dir, name, &flag)?;
-        if let Some((lo, hi)) = family_op.range() {
-            let last = *values.last().expect("a value list is never empty");
-            if values[0] < lo || last > hi {
-                anyhow::bail!(
-                    "--from/--to: {name} = {} ... {last} leaves the range [{lo}, {hi}] the \
-                     operator in {} declares",
-                    values[0],
-                    dir.display()
-                );
-            }
-        }
-        let first = family_op
-            .at(values[0])
-            .map_err(|e| anyhow::anyhow!("--from {}: {e}", values[0]))?;
-        first.check_pencil().map_err(|e| {
-            anyhow::anyhow!(
-                "--operator {} at {name} = {}: {e}",
-                dir.display(),
-                values[0]
-            )
-        })?;
-        let frictional = first.fm.compute_nnz() > 0
-            || first.fk.compute_nnz() > 0
-            || first.fc.as_ref().is_some_and(|f| f.compute_nnz() > 0);
-        let mu = match self.mu {
-            Some(mu) => mu,
-            None if frictional => anyhow::bail!(
-                "--mu: required, the operator in {} has friction parts (X - mu F_X)",
-                dir.display()
-            ),
-            None => 0.0,
+        let settings = ParamSweepSettings {
+            from: self.from,
+            to: self.to,
+            step: self.step,
+            mu: self.mu,
+            basis: self.method.basis.clone(),
+            basis_params: self.method.basis_params()?,
+            eigen: self.method.eigen(),
+            band_hz: self.method.band(crate::opts::OPERATOR_BAND_HZ)?,
+            tol: self.method.tol,
+            dvr_tol: self.method.dvr_tol,
+            condition: self.condition,
         };
-        // the points depend on these (not on the value list, except its first value,
-        // where the reference modes of tracking are taken)
-        let toml = std::fs::read_to_string(dir.join("operator.toml")).unwrap_or_default();
-        let mut inputs = serde_json::json!({
-            "operator": dir.display().to_string(),
-            "operator_toml": toml,
-            "parameter": name,
-            "reference_value": values[0],
-            "mu": mu,
-            "basis": self.method.basis,
-            "basis_opts": format!("{:?}", self.method.basis_params()?),
-            "eigen": self.method.eigen(),
-            "band_hz": band,
-            "tol": self.method.tol,
-            "squeal": env!("CARGO_PKG_VERSION"),
-        });
-        if self.condition {
-            inputs["condition"] = true.into();
-        }
+        let name = self.param.as_str();
+        let dir = &self.operator;
+        let family_op = crate::opts::read_parametric(dir, name, &format!("--param {name}"))?;
         let out = &self.out;
-        let (ckpt, done) = open_checkpoint(
-            out,
-            "sweep param",
-            "a parameter sweep",
-            self.resume,
-            &inputs,
-        )?;
-        let reference = reference_modes(registry, &first, "arpack", 1.5 * band[1])
-            .with_context(|| format!("--operator {} at {name} = {}", dir.display(), values[0]))?;
-        let mut method = Method::new(
+        crate::opts::set_resume_hint(out);
+        let dvr_tol = settings.dvr_tol;
+        let mut eta = crate::opts::Eta::new(0, 0);
+        let (summary, sweep) = squeal_analysis::param_sweep::run_into(
             registry,
-            &self.method.basis,
-            &self.method.basis_params()?,
-            &self.method.eigen(),
-            "arpack",
-            EigenParams {
-                fmin_hz: band[0],
-                fmax_hz: band[1],
-                tol: self.method.tol,
-                ..EigenParams::default()
-            },
-        )?;
-        method.set_condition(self.condition);
-        let mut eta = crate::opts::Eta::new(values.len(), done);
-        let dvr_tol = self.method.dvr_tol;
-        let mut family = Parametric::new(&family_op, mu);
-        let sweep = run_family_sweep(
-            &mut family,
-            &values,
-            &mut method,
-            &reference,
-            dvr_tol,
-            &[],
-            Some(&ckpt),
-            |p| {
-                let unstable = p.modes.iter().filter(|m| m.dvr > dvr_tol).count();
-                eprintln!(
-                    "{} {name} {}: {} modes, {} unstable, max error bound {}, solve {:.2} s",
-                    eta.tick(),
-                    p.value,
-                    p.modes.len(),
-                    unstable,
-                    crate::stability::sci(crate::stability::worst(
-                        &p.modes.iter().map(|m| m.error_bound).collect::<Vec<_>>()
-                    )),
-                    p.times_s[2]
-                );
+            dir,
+            &family_op,
+            name,
+            &settings,
+            out,
+            self.resume,
+            |e| match e {
+                SweepEvent::Opened { done, total } => {
+                    eta = crate::opts::Eta::new(total, done);
+                    if done > 0 {
+                        eprintln!(
+                            "resuming: {done} points already computed in {}",
+                            out.join("sweep.partial.jsonl").display()
+                        );
+                    }
+                }
+                SweepEvent::Point(p) => {
+                    let unstable = p.modes.iter().filter(|m| m.dvr > dvr_tol).count();
+                    eprintln!(
+                        "{} {name} {}: {} modes, {} unstable, max error bound {}, solve {:.2} s",
+                        eta.tick(),
+                        p.value,
+                        p.modes.len(),
+                        unstable,
+                        crate::stability::sci(squeal_analysis::sweep::files::worst(
+                            &p.modes.iter().map(|m| m.error_bound).collect::<Vec<_>>()
+                        )),
+                        p.times_s[2]
+                    );
+                }
             },
         )
-        .with_context(|| format!("the sweep of {name}"))?;
+        .map_err(|e| match e {
+            RunError::Input { field, message } => anyhow::anyhow!(
+                "{}: {message}",
+                field
+                    .split('/')
+                    .map(|f| format!("--{f}"))
+                    .collect::<Vec<_>>()
+                    .join("/")
+            ),
+            e => crate::opts::out_error(e),
+        })?;
         let axis = Axis::param(name);
-        let points = &sweep.points;
-        write_csv(
-            &out.join("sweep.csv"),
-            name,
-            points,
-            &sweep.branches,
-            dvr_tol,
-        )?;
-        charts(out, &axis, points, &sweep.branches, dvr_tol)?;
+        charts(out, &axis, &sweep.points, &sweep.branches, dvr_tol)?;
         mac_charts(out, &axis, &sweep.couplings)?;
-        let summary = ParamSummary {
-            operator: dir.display().to_string(),
-            units: "SI: frequencies in Hz, DvR = Re/Im (dimensionless), times in s",
-            parameter: name.to_string(),
-            range: [self.from, self.to, self.step],
-            mu,
-            band_hz: band,
-            eigen: self.method.eigen(),
-            basis: self.method.basis.clone(),
-            dofs: first.dim(),
-            dvr_tol,
-            points: points.len(),
-            max_basis_size: points.iter().map(|p| p.basis_size).max().unwrap_or(0),
-            max_backward_error: points
-                .iter()
-                .flat_map(|p| p.modes.iter().map(|m| m.backward_error))
-                .fold(0.0, f64::max),
-            max_error_bound: max_error_bound(points),
-            reference: reference_text(name, values[0], &reference),
-            reference_modes: reference.freq_hz.len(),
-            time_s: start.elapsed().as_secs_f64(),
-            couplings: sweep.couplings.clone(),
-        };
-        std::fs::write(
-            out.join("summary.json"),
-            serde_json::to_string_pretty(&summary)?,
-        )?;
         println!(
-            "{} points of {name} at mu = {mu}, {} couplings, max backward error {:.1e}, max \
+            "{} points of {name} at mu = {}, {} couplings, max backward error {:.1e}, max \
              error bound {}, {:.1} s",
             summary.points,
+            summary.mu,
             summary.couplings.len(),
             summary.max_backward_error,
             crate::stability::sci(summary.max_error_bound),
@@ -403,17 +296,6 @@ fn print_couplings<'a>(
     );
 }
 
-/// What the reference modes of a parameter sweep are.
-fn reference_text(name: &str, value: f64, reference: &FreeModes) -> String {
-    format!(
-        "{} real modes ({:.1} to {:.1} Hz) of the symmetric parts of M and K at {name} = \
-         {value} (no damping, gyroscopic, circulatory or friction term)",
-        reference.freq_hz.len(),
-        reference.freq_hz.first().copied().unwrap_or(0.0),
-        reference.freq_hz.last().copied().unwrap_or(0.0),
-    )
-}
-
 /// Inputs of a sweep.
 pub struct Args<'a> {
     pub scene: Option<&'a str>,
@@ -436,41 +318,12 @@ pub struct Args<'a> {
     pub out: &'a Path,
 }
 
-/// `summary.json`.
-#[derive(Serialize)]
-pub struct Summary {
-    pub scene: String,
-    pub units: &'static str,
-    pub mu: [f64; 3],
-    pub band_hz: [f64; 2],
-    pub eigen: String,
-    pub basis: String,
-    pub equilibrium: String,
-    pub law: String,
-    pub dofs: usize,
-    pub dvr_tol: f64,
-    pub points: usize,
-    pub rebuilds: usize,
-    pub max_basis_size: usize,
-    pub max_backward_error: f64,
-    /// Worst forward error estimate (`error_bound`) of every point's modes (null: not
-    /// computed).
-    pub max_error_bound: f64,
-    pub free_interface_modes: usize,
-    pub time_s: f64,
-    pub couplings: Vec<CouplingReport>,
-    /// Where the time went (points read back from a checkpoint excluded).
-    pub stages: Vec<StageTime>,
-    /// Peak resident memory of the process (MB).
-    pub peak_rss_mb: Option<f64>,
-}
-
 /// The range rule of every mu list (`--from/--to/--step`).
 pub fn mus(from: f64, to: f64, step: f64) -> Result<Vec<f64>> {
     mu_list(from, to, step).map_err(|e| anyhow::anyhow!("--from/--to/--step: {e}"))
 }
 
-pub fn run(registry: &Registry, a: &Args<'_>) -> Result<Summary> {
+pub fn run(registry: &Registry, a: &Args<'_>) -> Result<SweepSummary> {
     let mus = mus(a.from, a.to, a.step)?;
     let (scene, file) = crate::opts::load_scene(a.scene)?;
     let band = a.band.unwrap_or(scene.study.band_hz);
@@ -501,9 +354,9 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<Summary> {
     .0)
 }
 
-/// Runs the sweep `settings` of `prep` into `out` (checkpoint, CSV, charts, summary):
-/// the command's work, shared with `validate`. `range` is `[from, to, step]` as given;
-/// `setup` holds the stages run before (building `prep`), reported first.
+/// Runs the sweep `settings` of `prep` into `out` (checkpoint, CSV, summary) with
+/// progress lines, then draws its charts. `range` is `[from, to, step]` as given; `setup`
+/// holds the stages run before (building `prep`), reported first.
 pub fn run_on(
     registry: &Registry,
     prep: &Prepared,
@@ -512,50 +365,72 @@ pub fn run_on(
     out: &Path,
     resume: bool,
     setup: &Profile,
-) -> Result<(Summary, MuSweep)> {
-    let start = Instant::now();
-    // the points depend on these (not on the mu list: shards and extensions share them)
-    let mut inputs = serde_json::json!({
-        "scene": prep.scene.to_toml(),
-        "basis": settings.basis,
-        "basis_opts": format!("{:?}", settings.basis_params),
-        "eigen": settings.eigen,
-        "equilibrium": settings.equilibrium,
-        "law": settings.law,
-        "band_hz": settings.band_hz,
-        "tol": settings.tol,
-        "squeal": env!("CARGO_PKG_VERSION"),
-    });
-    if settings.condition {
-        inputs["condition"] = true.into();
-    }
-    let (ckpt, done) = open_checkpoint(out, "sweep mu", "a mu sweep", resume, &inputs)?;
-    let mut eta = crate::opts::Eta::new(settings.mus.len(), done);
+) -> Result<(SweepSummary, MuSweep)> {
+    crate::opts::set_resume_hint(out);
     let dvr_tol = settings.dvr_tol;
-    if done < settings.mus.len() {
-        eprintln!(
-            "free modes of the model (and the free-interface synthesis a basis such as `cms` \
-             works from) up to the needed cutoff: {} DOFs, the longest setup stage",
-            prep.model.dofs.n_free()
-        );
-    }
-    let sweep = run_sweep(registry, prep, settings, Some(&ckpt), |p| {
-        let unstable = p.modes.iter().filter(|m| m.dvr > dvr_tol).count();
-        eprintln!(
-            "{} mu {:.3}: {} modes, {} unstable, {} active pairs{}, solve {:.2} s",
-            eta.tick(),
-            p.mu,
-            p.modes.len(),
-            unstable,
-            p.active_pairs,
-            if p.rebuilt { " (new contact set)" } else { "" },
-            p.times_s[2]
-        );
+    let mut eta = crate::opts::Eta::new(settings.mus.len(), 0);
+    let (summary, sweep) = run_into(registry, prep, settings, range, out, resume, setup, |e| {
+        report_event(&mut eta, out, prep, dvr_tol, e)
     })
-    .context("the mu sweep")?;
-    let (points, branches, free) = (&sweep.points, &sweep.branches, &sweep.free);
-    write_csv(&out.join("sweep.csv"), "mu", points, branches, dvr_tol)?;
-    charts(out, &Axis::mu(), points, branches, dvr_tol)?;
+    .map_err(crate::opts::out_error)?;
+    sweep_charts(out, &sweep, dvr_tol)?;
+    let profile = Profile {
+        stages: summary.stages.clone(),
+    };
+    eprintln!(
+        "\nwhere the time went:\n{}",
+        profile.markdown(summary.time_s + setup.total_s())
+    );
+    Ok((summary, sweep))
+}
+
+/// Prints the progress line of a mu sweep's event (`eta` restarts when the checkpoint
+/// opens).
+pub fn report_event(
+    eta: &mut crate::opts::Eta,
+    out: &Path,
+    prep: &Prepared,
+    dvr_tol: f64,
+    event: SweepEvent<'_>,
+) {
+    match event {
+        SweepEvent::Opened { done, total } => {
+            *eta = crate::opts::Eta::new(total, done);
+            if done > 0 {
+                eprintln!(
+                    "resuming: {done} points already computed in {}",
+                    out.join("sweep.partial.jsonl").display()
+                );
+            }
+            if done < total {
+                eprintln!(
+                    "free modes of the model (and the free-interface synthesis a basis such \
+                     as `cms` works from) up to the needed cutoff: {} DOFs, the longest setup \
+                     stage",
+                    prep.model.dofs.n_free()
+                );
+            }
+        }
+        SweepEvent::Point(p) => {
+            let unstable = p.modes.iter().filter(|m| m.dvr > dvr_tol).count();
+            eprintln!(
+                "{} mu {:.3}: {} modes, {} unstable, {} active pairs{}, solve {:.2} s",
+                eta.tick(),
+                p.mu,
+                p.modes.len(),
+                unstable,
+                p.active_pairs,
+                if p.rebuilt { " (new contact set)" } else { "" },
+                p.times_s[2]
+            );
+        }
+    }
+}
+
+/// The charts of a finished mu sweep: frequency and DvR against mu (Figure 5), and the
+/// make-up of each coupling.
+pub fn sweep_charts(out: &Path, sweep: &MuSweep, dvr_tol: f64) -> Result<()> {
+    charts(out, &Axis::mu(), &sweep.points, &sweep.branches, dvr_tol)?;
     let makeup: Vec<SweepCoupling> = sweep
         .couplings
         .iter()
@@ -568,85 +443,7 @@ pub fn run_on(
             makeup: c.free_interface_mac.clone(),
         })
         .collect();
-    mac_charts(out, &Axis::mu(), &makeup)?;
-    let mut profile = setup.clone();
-    profile.extend_prefixed("", &sweep.profile);
-    let wall = start.elapsed().as_secs_f64() + setup.total_s();
-    eprintln!("\nwhere the time went:\n{}", profile.markdown(wall));
-    let summary = Summary {
-        scene: prep.file.clone(),
-        units: "SI: frequencies in Hz, DvR = Re/Im (dimensionless), times in s",
-        mu: range,
-        band_hz: settings.band_hz,
-        eigen: settings.eigen.clone(),
-        basis: settings.basis.clone(),
-        equilibrium: settings.equilibrium.clone(),
-        law: settings.law.clone(),
-        dofs: prep.model.dofs.n_free(),
-        dvr_tol,
-        points: points.len(),
-        rebuilds: points.iter().filter(|p| p.rebuilt).count(),
-        max_basis_size: points.iter().map(|p| p.basis_size).max().unwrap_or(0),
-        max_backward_error: points
-            .iter()
-            .flat_map(|p| p.modes.iter().map(|m| m.backward_error))
-            .fold(0.0, f64::max),
-        max_error_bound: max_error_bound(points),
-        free_interface_modes: free.freq_hz.len(),
-        time_s: start.elapsed().as_secs_f64(),
-        couplings: sweep.couplings.clone(),
-        stages: profile.stages,
-        peak_rss_mb: peak_rss_mb(),
-    };
-    std::fs::write(
-        out.join("summary.json"),
-        serde_json::to_string_pretty(&summary)?,
-    )?;
-    Ok((summary, sweep))
-}
-
-/// Claims `out` for `command` and opens its checkpoint: refuses a directory holding `what`
-/// (finished points or a summary) without `resume`, and a checkpoint of other `inputs`.
-/// Returns the checkpoint and how many points it holds.
-fn open_checkpoint(
-    out: &Path,
-    command: &str,
-    what: &str,
-    resume: bool,
-    inputs: &serde_json::Value,
-) -> Result<(Checkpoint, usize)> {
-    crate::opts::claim_out(out, command)?;
-    let ckpt_path = out.join("sweep.partial.jsonl");
-    let done = Checkpoint::new(ckpt_path.clone())
-        .load()
-        .map(|p| p.len())
-        .unwrap_or(0);
-    if (done > 0 || out.join("summary.json").is_file()) && !resume {
-        anyhow::bail!(
-            "--out {}: holds {what} ({done} finished points): pass --resume to continue it, \
-             or choose another directory",
-            out.display()
-        );
-    }
-    if done > 0 {
-        eprintln!(
-            "resuming: {done} points already computed in {}",
-            ckpt_path.display()
-        );
-    }
-    crate::opts::set_resume_hint(out);
-    let ckpt = Checkpoint::new(ckpt_path);
-    ckpt.claim(inputs).map_err(anyhow::Error::msg)?;
-    Ok((ckpt, done))
-}
-
-/// The worst `error_bound` of every point's modes (NaN when none was computed).
-fn max_error_bound(points: &[SweepPoint]) -> f64 {
-    let all: Vec<f64> = points
-        .iter()
-        .flat_map(|p| p.modes.iter().map(|m| m.error_bound))
-        .collect();
-    crate::stability::worst(&all)
+    mac_charts(out, &Axis::mu(), &makeup)
 }
 
 /// The swept quantity of charts and CSV: its column name, its axis label and the modes
@@ -676,56 +473,6 @@ impl Axis {
             reference: "the reference modes",
         }
     }
-}
-
-fn write_csv(
-    path: &Path,
-    column: &str,
-    points: &[SweepPoint],
-    branches: &[Branch],
-    tol: f64,
-) -> Result<()> {
-    let mut f = std::io::BufWriter::new(
-        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?,
-    );
-    writeln!(
-        f,
-        "{column},branch,mode,freq_hz,re,dvr,unstable,backward_error,cond,error_bound,active_pairs,basis_size"
-    )?;
-    // an estimate that was not computed is an empty field
-    let num = |x: f64| {
-        if x.is_nan() {
-            String::new()
-        } else {
-            format!("{x:.3e}")
-        }
-    };
-    for (p, pt) in points.iter().enumerate() {
-        for (m, md) in pt.modes.iter().enumerate() {
-            let b = branches
-                .iter()
-                .find(|b| b.modes[p] == Some(m))
-                .map_or(usize::MAX, |b| b.id);
-            writeln!(
-                f,
-                "{},{},{},{:.6},{:.6e},{:.6e},{},{:.3e},{},{},{},{}",
-                pt.value,
-                b,
-                m,
-                md.freq_hz,
-                // `+ 0.0` writes an undamped mode's -0 as 0
-                md.re + 0.0,
-                md.dvr + 0.0,
-                u8::from(md.dvr > tol),
-                md.backward_error,
-                num(md.cond),
-                num(md.error_bound),
-                pt.active_pairs,
-                pt.basis_size
-            )?;
-        }
-    }
-    Ok(())
 }
 
 fn charts(

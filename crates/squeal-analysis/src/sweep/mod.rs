@@ -39,6 +39,8 @@ pub fn active_hash(active: &[bool]) -> u64 {
 }
 use squeal_core::c64;
 
+pub mod files;
+
 /// One mode of a sweep point.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SweepMode {

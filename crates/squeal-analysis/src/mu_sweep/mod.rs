@@ -2,7 +2,8 @@
 //! free-interface modes (the reference of tracking), the method (full order or a basis),
 //! the points ([`crate::pipeline::run_mu_sweep`]), the tracked branches and the couplings
 //! with the free-interface modes each unstable mode is made of. `squeal sweep mu`,
-//! `validate` and the calibration's coupling targets all run it.
+//! `validate` and the calibration's coupling targets all run it; [`run_into`] runs it
+//! into an output directory (checkpoint, `sweep.csv`, `summary.json`).
 
 use crate::family::{run_family_sweep, SceneMu};
 use crate::pipeline::{FreeModes, Method, Prepared, Result};
@@ -11,6 +12,10 @@ use crate::sweep::{Branch, Checkpoint, SweepPoint};
 use serde::Serialize;
 use squeal_core::{EigenParams, Params, Registry};
 use std::time::Instant;
+
+mod dir;
+pub use crate::sweep::files::SweepEvent;
+pub use dir::{run_into, SweepSummary};
 
 /// What a sweep computes and how.
 #[derive(Debug, Clone)]

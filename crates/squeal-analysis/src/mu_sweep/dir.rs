@@ -1,0 +1,138 @@
+//! A mu sweep run into an output directory: its checkpoint (finished points survive a
+//! killed run and `resume` continues it), `sweep.csv` and `summary.json`. The charts are
+//! drawn by the caller from the returned sweep.
+
+use super::{run_sweep, CouplingReport, MuSweep, MuSweepSettings};
+use crate::outdir::{self, RunError};
+use crate::pipeline::Prepared;
+use crate::profile::{peak_rss_mb, Profile, StageTime};
+use crate::sweep::files::{max_error_bound, open_checkpoint, write_csv, SweepEvent};
+use serde::Serialize;
+use squeal_core::Registry;
+use std::path::Path;
+use std::time::Instant;
+
+/// `summary.json` of a mu sweep.
+#[derive(Serialize)]
+pub struct SweepSummary {
+    /// The scene's name in messages.
+    pub scene: String,
+    /// Units of the numbers.
+    pub units: &'static str,
+    /// `[from, to, step]` as given.
+    pub mu: [f64; 3],
+    /// Band (Hz).
+    pub band_hz: [f64; 2],
+    /// Eigen solver.
+    pub eigen: String,
+    /// Reduction basis (`none`: full order).
+    pub basis: String,
+    /// Equilibrium solver.
+    pub equilibrium: String,
+    /// Contact law.
+    pub law: String,
+    /// Free DOFs of the model.
+    pub dofs: usize,
+    /// A mode is unstable when its DvR exceeds this.
+    pub dvr_tol: f64,
+    /// Points of the sweep.
+    pub points: usize,
+    /// Points where the contact set changed (a new operator and basis).
+    pub rebuilds: usize,
+    /// Largest basis.
+    pub max_basis_size: usize,
+    /// Worst backward error of every point's modes.
+    pub max_backward_error: f64,
+    /// Worst forward error estimate (`error_bound`) of every point's modes (null: not
+    /// computed).
+    pub max_error_bound: f64,
+    /// Free-interface modes of tracking.
+    pub free_interface_modes: usize,
+    /// Wall time (s).
+    pub time_s: f64,
+    /// The couplings.
+    pub couplings: Vec<CouplingReport>,
+    /// Where the time went (points read back from a checkpoint excluded).
+    pub stages: Vec<StageTime>,
+    /// Peak resident memory of the process (MB).
+    pub peak_rss_mb: Option<f64>,
+}
+
+/// Runs the sweep `settings` of `prep` into `out`, claimed for `command`: checkpoint,
+/// `sweep.csv`, `summary.json`. `range` is `[from, to, step]` as given; `setup` holds the
+/// stages run before (building `prep`), reported first. A directory that holds finished
+/// points is continued with `resume` and refused without it.
+#[allow(clippy::too_many_arguments)]
+pub fn run_into(
+    registry: &Registry,
+    prep: &Prepared,
+    settings: &MuSweepSettings,
+    range: [f64; 3],
+    out: &Path,
+    resume: bool,
+    setup: &Profile,
+    mut events: impl FnMut(SweepEvent<'_>),
+) -> Result<(SweepSummary, MuSweep), RunError> {
+    let start = Instant::now();
+    // the points depend on these (not on the mu list: shards and extensions share them)
+    let mut inputs = serde_json::json!({
+        "scene": prep.scene.to_toml(),
+        "basis": settings.basis,
+        "basis_opts": format!("{:?}", settings.basis_params),
+        "eigen": settings.eigen,
+        "equilibrium": settings.equilibrium,
+        "law": settings.law,
+        "band_hz": settings.band_hz,
+        "tol": settings.tol,
+        "squeal": env!("CARGO_PKG_VERSION"),
+    });
+    if settings.condition {
+        inputs["condition"] = true.into();
+    }
+    let (ckpt, done) = open_checkpoint(out, "sweep mu", "a mu sweep", resume, &inputs)?;
+    events(SweepEvent::Opened {
+        done,
+        total: settings.mus.len(),
+    });
+    let sweep = run_sweep(registry, prep, settings, Some(&ckpt), |p| {
+        events(SweepEvent::Point(p))
+    })
+    .map_err(outdir::stage("the mu sweep"))?;
+    let points = &sweep.points;
+    write_csv(
+        &out.join("sweep.csv"),
+        "mu",
+        points,
+        &sweep.branches,
+        settings.dvr_tol,
+    )?;
+    let mut profile = setup.clone();
+    profile.extend_prefixed("", &sweep.profile);
+    let summary = SweepSummary {
+        scene: prep.file.clone(),
+        units: "SI: frequencies in Hz, DvR = Re/Im (dimensionless), times in s",
+        mu: range,
+        band_hz: settings.band_hz,
+        eigen: settings.eigen.clone(),
+        basis: settings.basis.clone(),
+        equilibrium: settings.equilibrium.clone(),
+        law: settings.law.clone(),
+        dofs: prep.model.dofs.n_free(),
+        dvr_tol: settings.dvr_tol,
+        points: points.len(),
+        rebuilds: points.iter().filter(|p| p.rebuilt).count(),
+        max_basis_size: points.iter().map(|p| p.basis_size).max().unwrap_or(0),
+        max_backward_error: points
+            .iter()
+            .flat_map(|p| p.modes.iter().map(|m| m.backward_error))
+            .fold(0.0, f64::max),
+        max_error_bound: max_error_bound(points),
+        free_interface_modes: sweep.free.freq_hz.len(),
+        time_s: start.elapsed().as_secs_f64(),
+        couplings: sweep.couplings.clone(),
+        stages: profile.stages,
+        peak_rss_mb: peak_rss_mb(),
+    };
+    outdir::write_json(&out.join("summary.json"), &summary)?;
+    Ok((summary, sweep))
+}
