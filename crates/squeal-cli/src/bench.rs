@@ -4,15 +4,13 @@
 use anyhow::{Context, Result};
 use serde::Serialize;
 use squeal_analysis::bench::{
-    bench_case, speed_ratios, BenchOptions, BenchRun, MemoryProbe, ReferenceSolve, SpeedRatio,
+    run_suite, BenchOptions, BenchRun, BenchSource, MemoryProbe, SuiteEvent, SuiteSettings,
 };
+use squeal_analysis::outdir::RunError;
 use squeal_analysis::pipeline::Prepared;
-use squeal_core::{FrictionalOperator, Registry};
+use squeal_core::Registry;
 use squeal_plot::{line_chart, pareto_chart, ChartOptions, Series, SeriesStyle};
-use squeal_scene::Zone;
-use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// The counting allocator of the binary, as a [`MemoryProbe`].
 pub struct HeapProbe(pub &'static peak_alloc::PeakAlloc);
@@ -181,118 +179,6 @@ pub struct Args<'a> {
     pub stress: bool,
 }
 
-/// `bench-summary.json`: what produced `bench.json`.
-#[derive(Serialize)]
-struct Summary<'a> {
-    source: String,
-    version: &'static str,
-    units: &'static str,
-    band_hz: [f64; 2],
-    tol: f64,
-    condition: bool,
-    reference_eigen: &'a str,
-    reference_tol: f64,
-    dvr_tol: f64,
-    accuracy: squeal_analysis::bench::Accuracy,
-    bases: &'a [String],
-    eigens: &'a [String],
-    vary: Vec<String>,
-    references: Vec<ReferenceSolve>,
-    speed_ratios: Vec<SpeedRatio>,
-    cases: Vec<CaseInfo>,
-    /// Model stages built once before the cases (e.g. the free-interface synthesis of
-    /// `cms`): `(key, time_s)`, not part of any run's time.
-    model_stages: Vec<(String, f64)>,
-    time_s: f64,
-    charts: Vec<String>,
-}
-
-/// One case: where its operator came from.
-#[derive(Serialize, Clone)]
-struct CaseInfo {
-    case: String,
-    mu: f64,
-    what: String,
-    active_pairs: Option<usize>,
-    dofs: usize,
-    operator_time_s: f64,
-}
-
-/// One stress case: a scene change, a mu and basis parameters chosen to break methods.
-struct StressCase {
-    name: &'static str,
-    what: &'static str,
-    mu: f64,
-    zone: Option<Zone>,
-    vary: Option<(&'static str, f64)>,
-}
-
-fn stress_cases() -> Vec<StressCase> {
-    vec![
-        StressCase {
-            name: "baseline",
-            what: "uniform contact, mu = 0.3: the reference point of each method's error estimate",
-            mu: 0.3,
-            zone: None,
-            vary: None,
-        },
-        StressCase {
-            name: "threshold",
-            what: "mu = 0.6, just past the onset of the 2150 Hz coupling of the default scene \
-                   (between 0.55 and 0.6): a small positive real part",
-            mu: 0.6,
-            zone: None,
-            vary: None,
-        },
-        StressCase {
-            name: "localized",
-            what: "contact zone 4 x 4 mm at the leading edge (x0 = 16 mm, y0 = 8 mm), mu = 0.43",
-            mu: 0.43,
-            zone: Some(Zone::Rectangle {
-                x0_m: 0.016,
-                y0_m: 0.008,
-                a_m: 0.004,
-                b_m: 0.004,
-            }),
-            vary: None,
-        },
-        StressCase {
-            name: "high-mu",
-            what: "mu = 1.2, far beyond the paper's range: strong friction coupling",
-            mu: 1.2,
-            zone: None,
-            vary: None,
-        },
-        StressCase {
-            name: "truncated",
-            what: "mu = 0.7 with every basis cut at the band top (cutoff_factor = 1)",
-            mu: 0.7,
-            zone: None,
-            vary: Some(("cutoff_factor", 1.0)),
-        },
-        StressCase {
-            name: "doublet",
-            what: "mu = 0.02: the disc's doublets split by the pin and barely coupled by \
-                   friction (near-degenerate pairs, DvR near 0 on both sides)",
-            mu: 0.02,
-            zone: None,
-            vary: None,
-        },
-    ]
-}
-
-/// Appends one run to `bench.partial.jsonl` at once (a killed bench keeps what finished).
-fn append(path: &Path, run: &BenchRun) -> Result<()> {
-    let mut f = std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(path)
-        .with_context(|| format!("opening {}", path.display()))?;
-    writeln!(f, "{}", serde_json::to_string(run)?)?;
-    f.flush()?;
-    Ok(())
-}
-
 fn print_run(r: &BenchRun) {
     let opts = if r.basis_opts.is_empty() {
         String::new()
@@ -348,48 +234,6 @@ fn times(x: f64) -> String {
     format!("x{v:.*}", digits(v))
 }
 
-struct Source {
-    name: String,
-    prep: Option<Prepared>,
-    op: Option<FrictionalOperator>,
-}
-
-/// The operator of a case: the scene's at its equilibrium for `mu` (or with a changed
-/// zone), or the operator directory's.
-fn case_operator(
-    registry: &Registry,
-    src: &mut Source,
-    a: &Args<'_>,
-    mu: f64,
-    zone: Option<&Zone>,
-) -> Result<(FrictionalOperator, Option<usize>, f64)> {
-    let t = Instant::now();
-    if let Some(op) = &src.op {
-        if zone.is_some() {
-            anyhow::bail!("a zone change needs a scene, not --operator");
-        }
-        return Ok((op.clone(), None, 0.0));
-    }
-    let base = src.prep.as_ref().expect("scene source");
-    let zoned;
-    let prep = match zone {
-        None => base,
-        Some(z) => {
-            let mut scene = base.scene.clone();
-            scene.contact.zone = z.clone();
-            zoned = Prepared::new(registry, scene, &src.name)?;
-            &zoned
-        }
-    };
-    let eq = prep.equilibrium(registry, a.equilibrium, a.law, mu)?;
-    let op = prep.operator(&eq.eq.active)?;
-    Ok((
-        op,
-        Some(eq.eq.active.iter().filter(|&&x| x).count()),
-        t.elapsed().as_secs_f64(),
-    ))
-}
-
 /// Redraws the charts (or the stress table) of a finished run from its `bench.json`
 /// (`stress.json`) in `out`.
 pub fn replot(out: &Path, stress: bool) -> Result<()> {
@@ -407,12 +251,8 @@ pub fn replot(out: &Path, stress: bool) -> Result<()> {
     Ok(())
 }
 
-/// Runs the bench (or the stress set) and writes its outputs.
-/// A benchmark case: name, description, mu, zone, one varied basis parameter.
-type BenchCase<'a> = (String, String, f64, Option<Zone>, Option<(&'a str, f64)>);
-
+/// Runs the bench (or the stress set), prints each run and writes its outputs and charts.
 pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -> Result<()> {
-    let start = Instant::now();
     // an operator directory is read (and checked) before anything is written
     let operator = match a.operator {
         Some(dir) => {
@@ -424,157 +264,78 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
                     "--stress changes the contact zone and mu: it needs a scene, not --operator"
                 );
             }
-            Some(Source {
+            Some(BenchSource::Operator {
                 name: match a.param {
                     Some(p) => format!("{} at {p}", dir.display()),
                     None => dir.display().to_string(),
                 },
-                prep: None,
-                op: Some(crate::opts::read_operator_at(dir, a.param)?),
+                op: Box::new(crate::opts::read_operator_at(dir, a.param)?),
             })
         }
         None => None,
     };
     crate::opts::claim_out(a.out, "bench")?;
-    let partial = a.out.join("bench.partial.jsonl");
-    let _ = std::fs::remove_file(&partial);
-    let mut src = match operator {
+    let src = match operator {
         Some(src) => src,
         None => {
             let (scene, file) = crate::opts::load_scene(a.scene)?;
-            let prep = Prepared::new(registry, scene, &file)?;
-            Source {
-                name: file,
-                prep: Some(prep),
-                op: None,
-            }
+            BenchSource::Scene(Box::new(Prepared::new(registry, scene, &file)?))
         }
     };
-    for &mu in a.mus {
-        squeal_contact::check_user_mu(mu)?;
-    }
     // the band: given, or the scene's (operator files: the default)
-    let mut base_opts = a.opts.clone();
-    base_opts.band_hz = a.band.unwrap_or(match &src.prep {
-        Some(prep) => prep.scene.study.band_hz,
-        None => crate::opts::OPERATOR_BAND_HZ,
+    let mut opts = a.opts.clone();
+    opts.band_hz = a.band.unwrap_or(match &src {
+        BenchSource::Scene(prep) => prep.scene.study.band_hz,
+        BenchSource::Operator { .. } => crate::opts::OPERATOR_BAND_HZ,
     });
-    if let Some(prep) = &src.prep {
-        crate::opts::check_band_against(base_opts.band_hz, &prep.scene)?;
+    if let BenchSource::Scene(prep) = &src {
+        crate::opts::check_band_against(opts.band_hz, &prep.scene)?;
     }
-    let cases: Vec<BenchCase<'_>> = if a.stress {
-        stress_cases()
-            .into_iter()
-            .map(|c| (c.name.to_string(), c.what.to_string(), c.mu, c.zone, c.vary))
-            .collect()
-    } else {
-        a.mus
-            .iter()
-            .map(|&mu| (format!("mu={mu}"), format!("mu = {mu}"), mu, None, None))
-            .collect()
+    let settings = SuiteSettings {
+        mus: a.mus.to_vec(),
+        opts,
+        equilibrium: a.equilibrium.into(),
+        law: a.law.into(),
+        stress: a.stress,
     };
-    // the model stages of the bases that have one (`cms`: the free-interface synthesis),
-    // on every pair of the face: a stress zone is a subset
-    let stages = match &src.prep {
-        Some(prep) => {
-            let all = squeal_contact::ContactSet::new(
-                &prep.model,
-                &Zone::Uniform,
-                prep.scene.study.rotation,
-            )?;
-            squeal_analysis::bench::stages_for(registry, &base_opts, &prep.model, &all)?
-        }
-        None => Vec::new(),
-    };
-    for s in &stages {
-        println!(
-            "model stage `{}`: built once in {:.1} s, shared by every case (not in the run times)",
-            s.key, s.time_s
-        );
-    }
-    let mut all_runs = Vec::new();
-    let mut refs = Vec::new();
-    let mut infos = Vec::new();
-    for (case, what, mu, zone, vary) in &cases {
-        println!("case {case}: {what}");
-        let (op, active, op_time) = case_operator(registry, &mut src, a, *mu, zone.as_ref())?;
-        infos.push(CaseInfo {
-            case: case.clone(),
-            mu: *mu,
-            what: what.clone(),
-            active_pairs: active,
-            dofs: op.dim(),
-            operator_time_s: op_time,
-        });
-        let mut opts = base_opts.clone();
-        if let Some((k, v)) = vary {
-            opts.vary = vec![(k.to_string(), vec![*v])];
-            opts.defaults = false;
-        }
-        let mut append_err = None;
-        let (reference, runs) = bench_case(registry, case, &op, &stages, *mu, &opts, probe, |r| {
-            print_run(r);
-            if let Err(e) = append(&partial, r) {
-                append_err.get_or_insert(e);
+    let (_, summary) = run_suite(
+        registry,
+        &src,
+        &settings,
+        a.out,
+        probe,
+        |e| match e {
+            SuiteEvent::Stage(s) => println!(
+                "model stage `{}`: built once in {:.1} s, shared by every case (not in the run \
+                 times)",
+                s.key, s.time_s
+            ),
+            SuiteEvent::Case(case, what) => println!("case {case}: {what}"),
+            SuiteEvent::Run(r) => print_run(r),
+            SuiteEvent::Reference(r) => println!(
+                "  reference `{}`: {} modes in band, {} unstable, {:.1} s",
+                r.eigen,
+                r.modes,
+                r.unstable.len(),
+                r.time_s
+            ),
+        },
+        |runs| {
+            if a.stress {
+                stress_report(a.out, runs)
+            } else {
+                charts(a.out, runs)
             }
-        })?;
-        if let Some(e) = append_err {
-            return Err(e);
-        }
-        println!(
-            "  reference `{}`: {} modes in band, {} unstable, {:.1} s",
-            reference.eigen,
-            reference.modes,
-            reference.unstable.len(),
-            reference.time_s
-        );
-        refs.push(reference);
-        all_runs.extend(runs);
-    }
-    let stem = if a.stress { "stress" } else { "bench" };
-    let json = a.out.join(format!("{stem}.json"));
-    std::fs::write(&json, serde_json::to_string_pretty(&all_runs)?)
-        .with_context(|| format!("writing {}", json.display()))?;
-    let charts = if a.stress {
-        stress_report(a.out, &all_runs)?
-    } else {
-        charts(a.out, &all_runs)?
-    };
-    let ratios = speed_ratios(&all_runs);
-    let summary = Summary {
-        source: src.name.clone(),
-        version: env!("CARGO_PKG_VERSION"),
-        units: "times in s, memory in MB (heap above the run's start), frequencies in Hz; \
-                errors relative (frequency) or absolute (DvR = Re/Im)",
-        band_hz: base_opts.band_hz,
-        tol: base_opts.tol,
-        condition: base_opts.condition,
-        reference_eigen: &base_opts.reference_eigen,
-        reference_tol: base_opts.reference_tol,
-        dvr_tol: base_opts.dvr_tol,
-        accuracy: base_opts.accuracy,
-        bases: &base_opts.bases,
-        eigens: &base_opts.eigens,
-        vary: a
-            .opts
-            .vary
-            .iter()
-            .map(|(k, v)| format!("{k}={v:?}"))
-            .collect(),
-        references: refs,
-        speed_ratios: ratios.clone(),
-        cases: infos,
-        model_stages: stages.iter().map(|s| (s.key.clone(), s.time_s)).collect(),
-        time_s: start.elapsed().as_secs_f64(),
-        charts: charts.iter().map(|p| p.display().to_string()).collect(),
-    };
-    let sj = a.out.join(format!("{stem}-summary.json"));
-    std::fs::write(&sj, serde_json::to_string_pretty(&summary)?)
-        .with_context(|| format!("writing {}", sj.display()))?;
-    let _ = std::fs::remove_file(&partial);
+            .map_err(|e| RunError::Output(format!("{e:#}")))
+        },
+    )
+    .map_err(|e| match e {
+        RunError::Input { field, message } => anyhow::anyhow!("--{field}: {message}"),
+        e => crate::opts::out_error(e),
+    })?;
     if !a.stress {
         println!("\nspeed-up over the reference at equal accuracy (fastest accurate run):");
-        for r in &ratios {
+        for r in &summary.speed_ratios {
             println!(
                 "  {:<8} {:<22} {:<20} total {:<9} per mu {}",
                 r.case,
@@ -585,11 +346,12 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
             );
         }
     }
+    let stem = if a.stress { "stress" } else { "bench" };
     println!(
         "wrote {}, {} and {} charts in {:.1} s",
-        json.display(),
-        sj.display(),
-        charts.len(),
+        a.out.join(format!("{stem}.json")).display(),
+        a.out.join(format!("{stem}-summary.json")).display(),
+        summary.charts.len(),
         summary.time_s
     );
     Ok(())

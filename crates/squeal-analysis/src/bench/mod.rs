@@ -19,6 +19,12 @@ use squeal_core::reduction::ReducedOperator;
 use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, ModelStage, Params, Registry};
 use std::time::Instant;
 
+mod suite;
+pub use suite::{
+    run_suite, stress_cases, BenchSource, CaseInfo, StressCase, SuiteEvent, SuiteSettings,
+    SuiteSummary,
+};
+
 /// A peak-memory probe. The `squeal` binary implements it with a counting global
 /// allocator; library users may pass `None` (memory is then not reported).
 pub trait MemoryProbe: Sync {
