@@ -170,6 +170,9 @@ impl Loader<'_> {
     }
 }
 
+/// The parameter's name and its declared range, from an operator.toml.
+type Header = (Option<String>, Option<(f64, f64)>);
+
 impl ParametricOperator {
     /// Reads the operator directory `dir`: its `operator.toml` when that declares
     /// `format = "squeal-parametric-operator"`, else (no description, or the summary
@@ -248,7 +251,8 @@ impl ParametricOperator {
         })
     }
 
-    fn from_table(dir: &Path, file: &Path, t: &toml::Table) -> Result<Self, IoError> {
+    /// Checks the top-level keys and the version; returns the parameter's name and range.
+    fn header(file: &Path, t: &toml::Table) -> Result<Header, IoError> {
         let expected_keys = format!("{} or a part {}", TOP_KEYS.join(", "), PARTS.join(", "));
         for k in t.keys() {
             if !TOP_KEYS.contains(&k.as_str()) && !PARTS.contains(&k.as_str()) {
@@ -310,11 +314,15 @@ impl ParametricOperator {
                 "`parameter` too",
             ));
         }
-        let default_mat = match t.get("mat") {
-            None => None,
-            Some(toml::Value::String(s)) => Some(dir.join(s)),
-            Some(v) => return Err(perr(file, "mat", format!("{v}"), "a file name (string)")),
-        };
+        Ok((parameter, range))
+    }
+
+    /// The `[components]` table: each component's file and variable.
+    fn component_sources(
+        dir: &Path,
+        file: &Path,
+        t: &toml::Table,
+    ) -> Result<BTreeMap<String, (PathBuf, Option<String>)>, IoError> {
         let mut components = BTreeMap::new();
         if let Some(c) = t.get("components") {
             let c = c
@@ -373,6 +381,82 @@ impl ParametricOperator {
                 components.insert(name.clone(), src);
             }
         }
+        Ok(components)
+    }
+
+    /// One term of a part, `field` in messages: its component name, its coefficient as
+    /// written and parsed.
+    fn term(
+        file: &Path,
+        field: &str,
+        item: &toml::Value,
+        parameter: Option<&str>,
+    ) -> Result<(String, String, Expr), IoError> {
+        let (name, coeff_text) = match item {
+            toml::Value::String(s) => (s.clone(), "1".to_string()),
+            toml::Value::Table(tb) => {
+                for k in tb.keys() {
+                    if k != "matrix" && k != "coeff" {
+                        return Err(perr(
+                            file,
+                            field,
+                            format!("unknown key `{k}`"),
+                            "matrix, coeff",
+                        ));
+                    }
+                }
+                let name = tb.get("matrix").and_then(|m| m.as_str()).ok_or_else(|| {
+                    perr(
+                        file,
+                        field,
+                        "no `matrix`",
+                        "{ matrix = \"KGeo\", coeff = \"W^2\" }",
+                    )
+                })?;
+                let coeff = match tb.get("coeff") {
+                    None => "1".to_string(),
+                    Some(toml::Value::String(s)) => s.clone(),
+                    Some(toml::Value::Float(x)) => format!("{x:?}"),
+                    Some(toml::Value::Integer(x)) => format!("{x}"),
+                    Some(v) => {
+                        return Err(perr(
+                            file,
+                            format!("{field}.coeff"),
+                            format!("{v}"),
+                            "a number or a formula string",
+                        ))
+                    }
+                };
+                (name.to_string(), coeff)
+            }
+            other => {
+                return Err(perr(
+                    file,
+                    field,
+                    format!("{other}"),
+                    "a component name or { matrix = ..., coeff = ... }",
+                ))
+            }
+        };
+        let coeff = Expr::parse(&coeff_text, parameter).map_err(|e| {
+            perr(
+                file,
+                format!("{field}.coeff"),
+                e,
+                "a formula of numbers, + - * / ^, ( ) and the parameter",
+            )
+        })?;
+        Ok((name, coeff_text, coeff))
+    }
+
+    fn from_table(dir: &Path, file: &Path, t: &toml::Table) -> Result<Self, IoError> {
+        let (parameter, range) = Self::header(file, t)?;
+        let default_mat = match t.get("mat") {
+            None => None,
+            Some(toml::Value::String(s)) => Some(dir.join(s)),
+            Some(v) => return Err(perr(file, "mat", format!("{v}"), "a file name (string)")),
+        };
+        let components = Self::component_sources(dir, file, t)?;
         let mut loader = Loader {
             dir,
             file,
@@ -408,60 +492,8 @@ impl ParametricOperator {
             }
             for (i, item) in list.iter().enumerate() {
                 let field = format!("{part}[{i}]");
-                let (name, coeff_text) = match item {
-                    toml::Value::String(s) => (s.clone(), "1".to_string()),
-                    toml::Value::Table(tb) => {
-                        for k in tb.keys() {
-                            if k != "matrix" && k != "coeff" {
-                                return Err(perr(
-                                    file,
-                                    &field,
-                                    format!("unknown key `{k}`"),
-                                    "matrix, coeff",
-                                ));
-                            }
-                        }
-                        let name = tb.get("matrix").and_then(|m| m.as_str()).ok_or_else(|| {
-                            perr(
-                                file,
-                                &field,
-                                "no `matrix`",
-                                "{ matrix = \"KGeo\", coeff = \"W^2\" }",
-                            )
-                        })?;
-                        let coeff = match tb.get("coeff") {
-                            None => "1".to_string(),
-                            Some(toml::Value::String(s)) => s.clone(),
-                            Some(toml::Value::Float(x)) => format!("{x:?}"),
-                            Some(toml::Value::Integer(x)) => format!("{x}"),
-                            Some(v) => {
-                                return Err(perr(
-                                    file,
-                                    format!("{field}.coeff"),
-                                    format!("{v}"),
-                                    "a number or a formula string",
-                                ))
-                            }
-                        };
-                        (name.to_string(), coeff)
-                    }
-                    other => {
-                        return Err(perr(
-                            file,
-                            &field,
-                            format!("{other}"),
-                            "a component name or { matrix = ..., coeff = ... }",
-                        ))
-                    }
-                };
-                let coeff = Expr::parse(&coeff_text, parameter.as_deref()).map_err(|e| {
-                    perr(
-                        file,
-                        format!("{field}.coeff"),
-                        e,
-                        "a formula of numbers, + - * / ^, ( ) and the parameter",
-                    )
-                })?;
+                let (name, coeff_text, coeff) =
+                    Self::term(file, &field, item, parameter.as_deref())?;
                 let (a, source) = loader.load(&name)?;
                 if dim.is_none() {
                     dim = Some((a.nrows(), source.clone()));

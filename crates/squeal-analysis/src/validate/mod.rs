@@ -276,47 +276,8 @@ pub fn run(
                 s.sweeps.len()
             ),
         );
-        let dir = out.join(format!("sweep-{basis}"));
-        if !s.resume {
-            // a new validation: the sweep starts afresh
-            for f in [
-                "sweep.partial.jsonl",
-                "sweep.partial.inputs.json",
-                "summary.json",
-            ] {
-                let _ = std::fs::remove_file(dir.join(f));
-            }
-        }
-        let mus = mu_list(0.0, 0.8, *step)
-            .map_err(|e| RunError::input(format!("sweeps[{i}].step"), e))?;
-        let settings = MuSweepSettings {
-            keep_modes_at: s.reference_mu.clone(),
-            ..MuSweepSettings::new(mus, basis, band)
-        };
-        let (summary, sweep) = run_into(
-            registry,
-            &prep,
-            &settings,
-            [0.0, 0.8, *step],
-            &dir,
-            true,
-            &Profile::new(),
-            |e| hooks.sweep_event(&dir, &prep, e),
-        )?;
-        hooks.sweep_done(&dir, &summary, &sweep)?;
-        for c in &paper().couplings {
-            let best = matching_coupling(&summary.couplings, c.freq_hz);
-            paper_rows.push(PaperRow {
-                paper_freq_hz: c.freq_hz,
-                paper_mu: c.mu_range,
-                basis: basis.clone(),
-                step: *step,
-                squeal_freq_hz: best.map(|c| c.freq_hz),
-                squeal_mu: best.map(|c| [c.mu_from, c.mu_to]),
-                max_dvr: best.map(|c| c.max_dvr),
-                made_of: best.map_or(Vec::new(), |c| c.free_interface_mac.clone()),
-            });
-        }
+        let (summary, sweep) = run_sweep(registry, &prep, s, i, band, out, hooks)?;
+        paper_rows.extend(paper_rows_of(basis, *step, &summary));
         detail.extend_prefixed(&format!("sweep {basis}: "), &sweep.profile);
         // a model stage (the synthesis of `cms`) is the largest thing the model keeps:
         // gone once no sweep ahead works from it (the references reuse the kept modes)
@@ -358,6 +319,70 @@ pub fn run(
     outdir::write(&out.join("report.md"), v.markdown())?;
     outdir::write_json(&out.join("report.json"), &v.json())?;
     Ok(v)
+}
+
+/// Runs sweep `i` of `s` into `out/sweep-<basis>` (afresh unless `s.resume`), keeping the
+/// modes at the reference mu.
+fn run_sweep(
+    registry: &Registry,
+    prep: &Prepared,
+    s: &ValidateSettings,
+    i: usize,
+    band: [f64; 2],
+    out: &Path,
+    hooks: &mut dyn ValidateHooks,
+) -> Result<(SweepSummary, MuSweep), RunError> {
+    let (basis, step) = &s.sweeps[i];
+    let dir = out.join(format!("sweep-{basis}"));
+    if !s.resume {
+        // a new validation: the sweep starts afresh
+        for f in [
+            "sweep.partial.jsonl",
+            "sweep.partial.inputs.json",
+            "summary.json",
+        ] {
+            let _ = std::fs::remove_file(dir.join(f));
+        }
+    }
+    let mus =
+        mu_list(0.0, 0.8, *step).map_err(|e| RunError::input(format!("sweeps[{i}].step"), e))?;
+    let settings = MuSweepSettings {
+        keep_modes_at: s.reference_mu.clone(),
+        ..MuSweepSettings::new(mus, basis, band)
+    };
+    let (summary, sweep) = run_into(
+        registry,
+        prep,
+        &settings,
+        [0.0, 0.8, *step],
+        &dir,
+        true,
+        &Profile::new(),
+        |e| hooks.sweep_event(&dir, prep, e),
+    )?;
+    hooks.sweep_done(&dir, &summary, &sweep)?;
+    Ok((summary, sweep))
+}
+
+/// The paper's couplings against the couplings of one sweep.
+fn paper_rows_of(basis: &str, step: f64, summary: &SweepSummary) -> Vec<PaperRow> {
+    paper()
+        .couplings
+        .iter()
+        .map(|c| {
+            let best = matching_coupling(&summary.couplings, c.freq_hz);
+            PaperRow {
+                paper_freq_hz: c.freq_hz,
+                paper_mu: c.mu_range,
+                basis: basis.to_string(),
+                step,
+                squeal_freq_hz: best.map(|c| c.freq_hz),
+                squeal_mu: best.map(|c| [c.mu_from, c.mu_to]),
+                max_dvr: best.map(|c| c.max_dvr),
+                made_of: best.map_or(Vec::new(), |c| c.free_interface_mac.clone()),
+            }
+        })
+        .collect()
 }
 
 /// Full-order solves at the reference mu, and every swept basis against them.
