@@ -132,20 +132,7 @@ pub fn calibrate(
                 &spec.targets,
                 &spec.search,
             )?;
-            ratios = fine
-                .measured
-                .iter()
-                .zip(&coarse_here.measured)
-                .zip(&spec.targets)
-                .map(|((f, c), t)| {
-                    let q = f.value / c.value;
-                    if t.scalable() && q.is_finite() && q > 0.0 {
-                        q
-                    } else {
-                        1.0
-                    }
-                })
-                .collect();
+            ratios = correction_ratios(&fine, &coarse_here, &spec.targets);
             dofs = [coarse_here.dofs, fine.dofs];
             record(step_of(
                 &steps,
@@ -191,61 +178,7 @@ pub fn calibrate(
             record: RefCell::new(&mut record),
             steps: &steps,
         };
-        let outcome = match spec.search.method {
-            Method::GaussNewton => {
-                let solver = Stalling {
-                    inner: TrustRegion::new(Steihaug::new().with_max_iters(50))
-                        .with_radius(0.4)
-                        .and_then(|t| t.with_max_radius(1.5))
-                        .map_err(|e| search_error(&e))?,
-                    tolerance: spec.search.tolerance,
-                    last_cost: f64::INFINITY,
-                    rejected: 0,
-                };
-                Executor::new(problem, solver)
-                    .configure(|s| s.param(z0).max_iters(1000))
-                    .ctrlc(false)
-                    .run()
-                    .map(|r| {
-                        let st = r.state();
-                        (
-                            st.get_best_param().cloned(),
-                            st.get_termination_reason().cloned(),
-                        )
-                    })
-            }
-            Method::NelderMead => {
-                // a simplex of steps of a tenth of each range around the start
-                let mut simplex = vec![z0.clone()];
-                for j in 0..n {
-                    let mut v = z0.clone();
-                    v[j] += if z0[j] > 0.0 { -0.3 } else { 0.3 };
-                    simplex.push(v);
-                }
-                let solver = NelderMead::new(simplex)
-                    .with_sd_tolerance(spec.search.tolerance)
-                    .map_err(|e| search_error(&e))?;
-                Executor::new(problem, solver)
-                    .configure(|s| s.max_iters(1000))
-                    .ctrlc(false)
-                    .run()
-                    .map(|r| {
-                        let st = r.state();
-                        (
-                            st.get_best_param().cloned(),
-                            st.get_termination_reason().cloned(),
-                        )
-                    })
-            }
-        };
-        let (best_z, stop) = match outcome {
-            Ok((z, reason)) => (
-                z,
-                reason.map_or("stopped".to_string(), |r| r.text().to_string()),
-            ),
-            Err(e) if e.to_string().contains(BUDGET) => (None, "evaluation budget used".into()),
-            Err(e) => return Err(search_error(&e)),
-        };
+        let (best_z, stop) = run_search(problem, spec, z0)?;
         // the best point evaluated in this round (argmin's best, or the history's when
         // the budget stopped it)
         let best = steps
@@ -299,6 +232,90 @@ pub fn calibrate(
         dofs,
         time_s: start_time.elapsed().as_secs_f64(),
     })
+}
+
+/// The correction ratio of each target: its value on the scene's own rule over its value
+/// on the search's coarse rule (1 where that is not a finite positive number or the
+/// target does not scale).
+fn correction_ratios(fine: &Evaluation, coarse: &Evaluation, targets: &[Target]) -> Vec<f64> {
+    fine.measured
+        .iter()
+        .zip(&coarse.measured)
+        .zip(targets)
+        .map(|((f, c), t)| {
+            let q = f.value / c.value;
+            if t.scalable() && q.is_finite() && q > 0.0 {
+                q
+            } else {
+                1.0
+            }
+        })
+        .collect()
+}
+
+/// Runs the spec's search method from `z0` on `problem`: the best point argmin reports
+/// (if any) and why it stopped.
+fn run_search(
+    problem: SearchProblem<'_, '_>,
+    spec: &CalibrationSpec,
+    z0: DVector<f64>,
+) -> Result<(Option<DVector<f64>>, String)> {
+    let n = z0.len();
+    let outcome = match spec.search.method {
+        Method::GaussNewton => {
+            let solver = Stalling {
+                inner: TrustRegion::new(Steihaug::new().with_max_iters(50))
+                    .with_radius(0.4)
+                    .and_then(|t| t.with_max_radius(1.5))
+                    .map_err(|e| search_error(&e))?,
+                tolerance: spec.search.tolerance,
+                last_cost: f64::INFINITY,
+                rejected: 0,
+            };
+            Executor::new(problem, solver)
+                .configure(|s| s.param(z0).max_iters(1000))
+                .ctrlc(false)
+                .run()
+                .map(|r| {
+                    let st = r.state();
+                    (
+                        st.get_best_param().cloned(),
+                        st.get_termination_reason().cloned(),
+                    )
+                })
+        }
+        Method::NelderMead => {
+            // a simplex of steps of a tenth of each range around the start
+            let mut simplex = vec![z0.clone()];
+            for j in 0..n {
+                let mut v = z0.clone();
+                v[j] += if z0[j] > 0.0 { -0.3 } else { 0.3 };
+                simplex.push(v);
+            }
+            let solver = NelderMead::new(simplex)
+                .with_sd_tolerance(spec.search.tolerance)
+                .map_err(|e| search_error(&e))?;
+            Executor::new(problem, solver)
+                .configure(|s| s.max_iters(1000))
+                .ctrlc(false)
+                .run()
+                .map(|r| {
+                    let st = r.state();
+                    (
+                        st.get_best_param().cloned(),
+                        st.get_termination_reason().cloned(),
+                    )
+                })
+        }
+    };
+    match outcome {
+        Ok((z, reason)) => Ok((
+            z,
+            reason.map_or("stopped".to_string(), |r| r.text().to_string()),
+        )),
+        Err(e) if e.to_string().contains(BUDGET) => Ok((None, "evaluation budget used".into())),
+        Err(e) => Err(search_error(&e)),
+    }
 }
 
 /// The base scene with the parameters at `values` and the rule overrides `rule`.
