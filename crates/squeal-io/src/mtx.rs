@@ -91,33 +91,20 @@ fn shown(line: &str) -> String {
     }
 }
 
-/// Reads Matrix Market text from any buffered reader; `file` names the source in errors.
-///
-/// # Errors
-/// As [`read_mtx`].
-pub fn read_mtx_from<R: BufRead>(mut reader: R, file: &Path) -> Result<SparseMat, IoError> {
-    let syntax = |line: usize, problem: String, expected: &str| IoError::Syntax {
+/// A syntax error at `line` of `file`.
+fn syntax_at(file: &Path, line: usize, problem: String, expected: &str) -> IoError {
+    IoError::Syntax {
         file: file.to_path_buf(),
         line,
         problem,
         expected: expected.to_string(),
-    };
-    let mut buf = String::new();
-    let mut lineno = 0usize;
-    // Reads the next line into `buf`; false at end of file.
-    let mut next = |buf: &mut String, lineno: &mut usize| -> Result<bool, IoError> {
-        buf.clear();
-        let n = reader.read_line(buf).map_err(|e| io_err(file, "read", e))?;
-        if n > 0 {
-            *lineno += 1;
-        }
-        Ok(n > 0)
-    };
-
-    // Banner.
-    if !next(&mut buf, &mut lineno)? {
-        return Err(syntax(1, "the file is empty".into(), EXPECTED_BANNER));
     }
+}
+
+/// Checks the banner line `buf` of `file`; whether the matrix is stored symmetric.
+fn banner(file: &Path, buf: &str) -> Result<bool, IoError> {
+    let syntax =
+        |line: usize, problem: String, expected: &str| syntax_at(file, line, problem, expected);
     let tokens: Vec<String> = buf
         .split_whitespace()
         .map(|t| t.to_ascii_lowercase())
@@ -125,7 +112,7 @@ pub fn read_mtx_from<R: BufRead>(mut reader: R, file: &Path) -> Result<SparseMat
     if tokens.first().map(String::as_str) != Some("%%matrixmarket") {
         return Err(syntax(
             1,
-            format!("`{}` is not a Matrix Market banner", shown(&buf)),
+            format!("`{}` is not a Matrix Market banner", shown(buf)),
             EXPECTED_BANNER,
         ));
     }
@@ -134,7 +121,7 @@ pub fn read_mtx_from<R: BufRead>(mut reader: R, file: &Path) -> Result<SparseMat
             1,
             format!(
                 "banner `{}` has {} words instead of 5",
-                shown(&buf),
+                shown(buf),
                 tokens.len()
             ),
             EXPECTED_BANNER,
@@ -176,6 +163,113 @@ pub fn read_mtx_from<R: BufRead>(mut reader: R, file: &Path) -> Result<SparseMat
             ))
         }
     };
+
+    Ok(symmetric)
+}
+
+/// One entry line `t` (line `lineno` of `file`) of a matrix of `size`: 1-based row,
+/// column and value, checked.
+fn entry(
+    file: &Path,
+    lineno: usize,
+    t: &str,
+    size: [usize; 2],
+    symmetric: bool,
+) -> Result<(usize, usize, f64), IoError> {
+    let [nrows, ncols] = size;
+    let syntax =
+        |line: usize, problem: String, expected: &str| syntax_at(file, line, problem, expected);
+    let parts: Vec<&str> = t.split_whitespace().collect();
+    if parts.len() != 3 {
+        return Err(syntax(
+            lineno,
+            format!(
+                "entry `{}` has {} fields instead of 3",
+                shown(t),
+                parts.len()
+            ),
+            EXPECTED_ENTRY,
+        ));
+    }
+    let index = |s: &str, what: &str| {
+        s.parse::<usize>().map_err(|_| {
+            syntax(
+                lineno,
+                format!(
+                    "{what} index `{s}` in `{}` is not a non-negative integer",
+                    shown(t)
+                ),
+                EXPECTED_ENTRY,
+            )
+        })
+    };
+    let row = index(parts[0], "row")?;
+    let col = index(parts[1], "column")?;
+    let val: f64 = parts[2].parse().map_err(|_| {
+        syntax(
+            lineno,
+            format!(
+                "value `{}` in `{}` is not a real number",
+                parts[2],
+                shown(t)
+            ),
+            EXPECTED_ENTRY,
+        )
+    })?;
+    if row == 0 || col == 0 || row > nrows || col > ncols {
+        return Err(IoError::IndexOutOfRange {
+            file: file.to_path_buf(),
+            line: lineno,
+            row,
+            col,
+            nrows,
+            ncols,
+        });
+    }
+    if !val.is_finite() {
+        return Err(IoError::NonFinite {
+            file: file.to_path_buf(),
+            line: Some(lineno),
+            row,
+            col,
+            value: parts[2].to_string(),
+        });
+    }
+    if symmetric && row < col {
+        return Err(IoError::UpperTriangle {
+            file: file.to_path_buf(),
+            line: lineno,
+            row,
+            col,
+        });
+    }
+    Ok((row, col, val))
+}
+
+/// Reads Matrix Market text from any buffered reader; `file` names the source in errors.
+///
+/// # Errors
+/// As [`read_mtx`].
+pub fn read_mtx_from<R: BufRead>(mut reader: R, file: &Path) -> Result<SparseMat, IoError> {
+    let syntax =
+        |line: usize, problem: String, expected: &str| syntax_at(file, line, problem, expected);
+    let mut buf = String::new();
+    let mut lineno = 0usize;
+    // Reads the next line into `buf`; false at end of file.
+    let mut next = |buf: &mut String, lineno: &mut usize| -> Result<bool, IoError> {
+        buf.clear();
+        let n = reader.read_line(buf).map_err(|e| io_err(file, "read", e))?;
+        if n > 0 {
+            *lineno += 1;
+        }
+        Ok(n > 0)
+    };
+
+    // Banner.
+    if !next(&mut buf, &mut lineno)? {
+        return Err(syntax(1, "the file is empty".into(), EXPECTED_BANNER));
+    }
+    let symmetric = banner(file, &buf)?;
 
     // Size line (after comments and blank lines).
     let (nrows, ncols, declared) = loop {
@@ -229,70 +323,7 @@ pub fn read_mtx_from<R: BufRead>(mut reader: R, file: &Path) -> Result<SparseMat
                 found: found + 1,
             });
         }
-        let parts: Vec<&str> = t.split_whitespace().collect();
-        if parts.len() != 3 {
-            return Err(syntax(
-                lineno,
-                format!(
-                    "entry `{}` has {} fields instead of 3",
-                    shown(t),
-                    parts.len()
-                ),
-                EXPECTED_ENTRY,
-            ));
-        }
-        let index = |s: &str, what: &str| {
-            s.parse::<usize>().map_err(|_| {
-                syntax(
-                    lineno,
-                    format!(
-                        "{what} index `{s}` in `{}` is not a non-negative integer",
-                        shown(t)
-                    ),
-                    EXPECTED_ENTRY,
-                )
-            })
-        };
-        let row = index(parts[0], "row")?;
-        let col = index(parts[1], "column")?;
-        let val: f64 = parts[2].parse().map_err(|_| {
-            syntax(
-                lineno,
-                format!(
-                    "value `{}` in `{}` is not a real number",
-                    parts[2],
-                    shown(t)
-                ),
-                EXPECTED_ENTRY,
-            )
-        })?;
-        if row == 0 || col == 0 || row > nrows || col > ncols {
-            return Err(IoError::IndexOutOfRange {
-                file: file.to_path_buf(),
-                line: lineno,
-                row,
-                col,
-                nrows,
-                ncols,
-            });
-        }
-        if !val.is_finite() {
-            return Err(IoError::NonFinite {
-                file: file.to_path_buf(),
-                line: Some(lineno),
-                row,
-                col,
-                value: parts[2].to_string(),
-            });
-        }
-        if symmetric && row < col {
-            return Err(IoError::UpperTriangle {
-                file: file.to_path_buf(),
-                line: lineno,
-                row,
-                col,
-            });
-        }
+        let (row, col, val) = entry(file, lineno, t, [nrows, ncols], symmetric)?;
         trip.push((row - 1, col - 1, val));
         if symmetric && row != col {
             trip.push((col - 1, row - 1, val));
