@@ -358,6 +358,18 @@ fn masks_and_plateaus_are_checked_and_reproducible() {
     for r in &a {
         assert!(r[0] >= 0.0 && r[0] + r[2] <= 0.02 + 1e-12 && r[1] + r[3] <= 0.02 + 1e-12);
     }
+    // a larger fraction with the same seed keeps every patch of the smaller one (the
+    // layouts of a fraction study are nested)
+    let at = |fraction: f64| squeal_scene::Zone::Plateaus {
+        patch_m: 0.002,
+        seed: 7,
+        fraction: Some(fraction),
+        count: None,
+        region_m: None,
+    };
+    let more = at(0.6).plateau_rectangles(size).unwrap();
+    assert_eq!(more.len(), 60);
+    assert!(a.iter().all(|r| more.contains(r)));
     let mut bad = base.clone();
     bad.contact.zone = squeal_scene::Zone::Plateaus {
         patch_m: 0.05,

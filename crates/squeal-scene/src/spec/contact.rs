@@ -28,7 +28,8 @@ pub enum Zone {
     /// `region_m = [x0, y0, a, b]` as for `rectangle`) is cut into square patches of side
     /// `patch_m`, and a seeded random subset of them (`fraction` of the patches, or
     /// `count` patches) may touch. The same seed gives the same layout on every machine
-    /// (splitmix64 + Fisher-Yates).
+    /// (splitmix64 + Fisher-Yates), and a larger fraction with the same seed keeps every
+    /// patch of a smaller one.
     Plateaus {
         /// Patch side (m).
         patch_m: f64,
