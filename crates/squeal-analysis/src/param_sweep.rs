@@ -155,7 +155,7 @@ pub fn run_into(
     // the points depend on these (not on the value list, except its first value, where
     // the reference modes of tracking are taken)
     let toml = std::fs::read_to_string(dir.join("operator.toml")).unwrap_or_default();
-    let mut inputs = serde_json::json!({
+    let inputs = serde_json::json!({
         "operator": dir.display().to_string(),
         "operator_toml": toml,
         "parameter": name,
@@ -168,14 +168,16 @@ pub fn run_into(
         "tol": s.tol,
         "squeal": env!("CARGO_PKG_VERSION"),
     });
-    if s.condition {
-        inputs["condition"] = true.into();
-    }
-    let (ckpt, done) = open_checkpoint(out, "sweep param", "a parameter sweep", resume, &inputs)?;
-    events(SweepEvent::Opened {
-        done,
-        total: values.len(),
-    });
+    let ckpt = open_checkpoint(
+        out,
+        "sweep param",
+        "a parameter sweep",
+        resume,
+        inputs,
+        s.condition,
+        values.len(),
+        &mut events,
+    )?;
     let at_first = || outdir::stage(format!("{} at {name} = {}", dir.display(), values[0]));
     let reference =
         reference_modes(registry, &first, "arpack", 1.5 * s.band_hz[1]).map_err(at_first())?;

@@ -75,7 +75,7 @@ pub fn run_into(
 ) -> Result<(SweepSummary, MuSweep), RunError> {
     let start = Instant::now();
     // the points depend on these (not on the mu list: shards and extensions share them)
-    let mut inputs = serde_json::json!({
+    let inputs = serde_json::json!({
         "scene": prep.scene.to_toml(),
         "basis": settings.basis,
         "basis_opts": format!("{:?}", settings.basis_params),
@@ -86,14 +86,16 @@ pub fn run_into(
         "tol": settings.tol,
         "squeal": env!("CARGO_PKG_VERSION"),
     });
-    if settings.condition {
-        inputs["condition"] = true.into();
-    }
-    let (ckpt, done) = open_checkpoint(out, "sweep mu", "a mu sweep", resume, &inputs)?;
-    events(SweepEvent::Opened {
-        done,
-        total: settings.mus.len(),
-    });
+    let ckpt = open_checkpoint(
+        out,
+        "sweep mu",
+        "a mu sweep",
+        resume,
+        inputs,
+        settings.condition,
+        settings.mus.len(),
+        &mut events,
+    )?;
     let sweep = run_sweep(registry, prep, settings, Some(&ckpt), |p| {
         events(SweepEvent::Point(p))
     })

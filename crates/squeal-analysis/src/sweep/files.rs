@@ -22,14 +22,22 @@ pub enum SweepEvent<'a> {
 
 /// Claims `out` for `command` and opens its checkpoint: refuses a directory holding
 /// `what` (finished points or a summary) without `resume`, and a checkpoint of other
-/// `inputs`. Returns the checkpoint and how many points it holds.
+/// `inputs` (with `"condition": true` added when `condition`). Tells `events` how many of
+/// the `total` points it holds, and returns it.
+#[allow(clippy::too_many_arguments)]
 pub fn open_checkpoint(
     out: &Path,
     command: &str,
     what: &str,
     resume: bool,
-    inputs: &serde_json::Value,
-) -> Result<(Checkpoint, usize), RunError> {
+    mut inputs: serde_json::Value,
+    condition: bool,
+    total: usize,
+    events: &mut impl FnMut(SweepEvent<'_>),
+) -> Result<Checkpoint, RunError> {
+    if condition {
+        inputs["condition"] = true.into();
+    }
     outdir::claim(out, command)?;
     let ckpt_path = out.join("sweep.partial.jsonl");
     let done = Checkpoint::new(ckpt_path.clone())
@@ -46,11 +54,12 @@ pub fn open_checkpoint(
         });
     }
     let ckpt = Checkpoint::new(ckpt_path);
-    ckpt.claim(inputs).map_err(|message| RunError::Dir {
+    ckpt.claim(&inputs).map_err(|message| RunError::Dir {
         path: out.to_path_buf(),
         message,
     })?;
-    Ok((ckpt, done))
+    events(SweepEvent::Opened { done, total });
+    Ok(ckpt)
 }
 
 /// The largest of `values` that are not NaN (NaN when all are, or there are none).
