@@ -11,7 +11,7 @@ use crate::pipeline::{PipelineError, Prepared, Result};
 use serde::Serialize;
 use squeal_core::faer::Mat;
 use squeal_core::linalg::spmv;
-use squeal_core::{EigenParams, Params, RealModes, Registry, SymmetricProblem};
+use squeal_core::{EigenParams, EigenSolver, Params, RealModes, Registry, SymmetricProblem};
 use squeal_scene::{build, BodyKind, Model, Scene};
 use std::time::Instant;
 
@@ -90,37 +90,7 @@ pub fn evaluate(
     search: &Search,
 ) -> Result<Evaluation> {
     let start = Instant::now();
-    // contact targets need the whole rig and its condensation; modal targets only the
-    // bodies they name
-    let contact = targets.iter().any(|t| {
-        matches!(
-            t.kind,
-            TargetKind::Stiffness { .. }
-                | TargetKind::TiedMode { .. }
-                | TargetKind::Coupling { .. }
-        )
-    });
-    let (prep, own) = if contact {
-        (Some(Prepared::new(registry, scene.clone(), file)?), None)
-    } else {
-        let bodies: Vec<&str> = targets
-            .iter()
-            .filter_map(|t| match &t.kind {
-                TargetKind::Mode { body, .. } | TargetKind::ModeCount { body, .. } => {
-                    Some(body.as_str())
-                }
-                _ => None,
-            })
-            .collect();
-        let which = if bodies.iter().all(|b| *b == "disc") {
-            BodyKind::Disc
-        } else if bodies.iter().all(|b| *b == "pin") {
-            BodyKind::Pin
-        } else {
-            BodyKind::All
-        };
-        (None, Some(build(scene, which, registry, file)?))
-    };
+    let (prep, own) = build_for(registry, scene, file, targets)?;
     let model = match (&prep, &own) {
         (Some(p), _) => &p.model,
         (None, Some(m)) => m,
@@ -130,37 +100,7 @@ pub fn evaluate(
         .eigen
         .create(&search.eigen, &Params::new())
         .map_err(|e| core("eigen solver", e))?;
-    // the free-interface modes reach past every frequency a target looks at
-    let top = targets
-        .iter()
-        .map(|t| match &t.kind {
-            TargetKind::Stiffness { .. } => 0.0,
-            TargetKind::Mode { freq_hz, .. } => 1.3 * freq_hz,
-            TargetKind::ModeCount { below_hz, .. } => 1.3 * below_hz,
-            TargetKind::Coupling { .. } => 0.0,
-            TargetKind::TiedMode { .. } => 1.5 * window(t)[1],
-        })
-        .fold(0.0, f64::max);
-    let free = if top > 0.0 {
-        let params = EigenParams {
-            fmax_hz: top,
-            tol: 1e-10,
-            ..EigenParams::default()
-        };
-        let modes = solver
-            .solve_symmetric(
-                &SymmetricProblem {
-                    k: model.k.as_ref(),
-                    m: model.m.as_ref(),
-                },
-                &params,
-            )
-            .map_err(|e| core("free-interface modes", e))?;
-        let records = label_modes(model, &modes);
-        Some((modes, records))
-    } else {
-        None
-    };
+    let (top, free) = free_modes(solver.as_ref(), model, targets)?;
     let mphi = free.as_ref().map(|(m, _)| times_mass(model, m));
     let mut tied_cache: Vec<(Option<u64>, RealModes, Vec<Vec<f64>>)> = Vec::new();
     let mut sweep: Option<MuSweep> = None;
@@ -188,27 +128,7 @@ pub fn evaluate(
                 freq_hz,
             } => {
                 let (_, records) = free.as_ref().expect("free modes solved");
-                let f: Vec<f64> = records
-                    .iter()
-                    .filter(|r| &r.body == body && &r.label == label)
-                    .map(|r| r.freq_hz)
-                    .collect();
-                let pick: Vec<f64> = if body == "disc" {
-                    f.iter().take(2).copied().collect()
-                } else {
-                    f.iter().take(1).copied().collect()
-                };
-                if pick.is_empty() {
-                    missing(format!("no {body} mode labelled {label} below {top:.0} Hz"))
-                } else {
-                    let v = pick.iter().sum::<f64>() / pick.len() as f64;
-                    Measured {
-                        extra: Vec::new(),
-                        value: v,
-                        residual: (v / freq_hz).ln(),
-                        note: format!("{} mode(s)", pick.len()),
-                    }
-                }
+                mode_measure(records, body, label, *freq_hz, top)
             }
             TargetKind::ModeCount {
                 body,
@@ -277,6 +197,122 @@ pub fn evaluate(
         dofs: model.m.nrows(),
         time_s: start.elapsed().as_secs_f64(),
     })
+}
+
+/// What the targets need built: the whole rig with its condensation (contact targets),
+/// or only the bodies the modal targets name.
+fn build_for(
+    registry: &Registry,
+    scene: &Scene,
+    file: &str,
+    targets: &[Target],
+) -> Result<(Option<Prepared>, Option<Model>)> {
+    // contact targets need the whole rig and its condensation; modal targets only the
+    // bodies they name
+    let contact = targets.iter().any(|t| {
+        matches!(
+            t.kind,
+            TargetKind::Stiffness { .. }
+                | TargetKind::TiedMode { .. }
+                | TargetKind::Coupling { .. }
+        )
+    });
+    Ok(if contact {
+        (Some(Prepared::new(registry, scene.clone(), file)?), None)
+    } else {
+        let bodies: Vec<&str> = targets
+            .iter()
+            .filter_map(|t| match &t.kind {
+                TargetKind::Mode { body, .. } | TargetKind::ModeCount { body, .. } => {
+                    Some(body.as_str())
+                }
+                _ => None,
+            })
+            .collect();
+        let which = if bodies.iter().all(|b| *b == "disc") {
+            BodyKind::Disc
+        } else if bodies.iter().all(|b| *b == "pin") {
+            BodyKind::Pin
+        } else {
+            BodyKind::All
+        };
+        (None, Some(build(scene, which, registry, file)?))
+    })
+}
+
+/// Free-interface modes with their labels.
+type FreeModes = (RealModes, Vec<ModeRecord>);
+
+/// The free-interface modes of `model` up to past every frequency a target looks at
+/// (that top, and the modes with their labels; none when no target needs them).
+fn free_modes(
+    solver: &dyn EigenSolver,
+    model: &Model,
+    targets: &[Target],
+) -> Result<(f64, Option<FreeModes>)> {
+    let top = targets
+        .iter()
+        .map(|t| match &t.kind {
+            TargetKind::Stiffness { .. } => 0.0,
+            TargetKind::Mode { freq_hz, .. } => 1.3 * freq_hz,
+            TargetKind::ModeCount { below_hz, .. } => 1.3 * below_hz,
+            TargetKind::Coupling { .. } => 0.0,
+            TargetKind::TiedMode { .. } => 1.5 * window(t)[1],
+        })
+        .fold(0.0, f64::max);
+    let free = if top > 0.0 {
+        let params = EigenParams {
+            fmax_hz: top,
+            tol: 1e-10,
+            ..EigenParams::default()
+        };
+        let modes = solver
+            .solve_symmetric(
+                &SymmetricProblem {
+                    k: model.k.as_ref(),
+                    m: model.m.as_ref(),
+                },
+                &params,
+            )
+            .map_err(|e| core("free-interface modes", e))?;
+        let records = label_modes(model, &modes);
+        Some((modes, records))
+    } else {
+        None
+    };
+    Ok((top, free))
+}
+
+/// A labelled mode target: the mean frequency of the body's modes with that label (the
+/// two members of a disc doublet).
+fn mode_measure(
+    records: &[ModeRecord],
+    body: &str,
+    label: &str,
+    freq_hz: f64,
+    top: f64,
+) -> Measured {
+    let f: Vec<f64> = records
+        .iter()
+        .filter(|r| r.body == body && r.label == label)
+        .map(|r| r.freq_hz)
+        .collect();
+    let pick: Vec<f64> = if body == "disc" {
+        f.iter().take(2).copied().collect()
+    } else {
+        f.iter().take(1).copied().collect()
+    };
+    if pick.is_empty() {
+        missing(format!("no {body} mode labelled {label} below {top:.0} Hz"))
+    } else {
+        let v = pick.iter().sum::<f64>() / pick.len() as f64;
+        Measured {
+            extra: Vec::new(),
+            value: v,
+            residual: (v / freq_hz).ln(),
+            note: format!("{} mode(s)", pick.len()),
+        }
+    }
 }
 
 fn core(stage: &str, source: squeal_core::Error) -> PipelineError {
