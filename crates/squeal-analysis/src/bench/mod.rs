@@ -500,12 +500,7 @@ pub fn bench_case(
     memory: Option<&dyn MemoryProbe>,
     mut on_run: impl FnMut(&BenchRun),
 ) -> Result<(ReferenceSolve, Vec<BenchRun>)> {
-    let create = |name: &str| -> Result<Box<dyn EigenSolver>> {
-        registry
-            .eigen
-            .create(name, &Params::new())
-            .map_err(core(format!("eigen solver `{name}`")))
-    };
+    let create = |name: &str| eigen_solver(registry, name);
     // the reference
     let meter = Meter::start(memory);
     let t = Instant::now();
@@ -617,32 +612,7 @@ pub fn bench_case(
         for (label, p) in variants(registry, basis, opts) {
             let meter = Meter::start(memory);
             let t = Instant::now();
-            let built = (|| -> Result<ReducedOperator> {
-                let plugin = registry
-                    .bases
-                    .create(basis, &p)
-                    .map_err(core(format!("basis `{basis}`")))?;
-                let modal = create(&opts.modal)?;
-                let dense = create("dense")?;
-                let stage = plugin.stage_key(opts.band_hz[1]).and_then(|key| {
-                    stages
-                        .iter()
-                        .find(|s| s.key == key)
-                        .map(|s| s.stage.as_ref())
-                });
-                let req = BasisRequest {
-                    op,
-                    mu,
-                    band_hz: (opts.band_hz[0], opts.band_hz[1]),
-                    modal: modal.as_ref(),
-                    reduced: dense.as_ref(),
-                    params: &params,
-                    stage,
-                };
-                let b = squeal_core::contact::build_basis(plugin.as_ref(), &req)
-                    .map_err(core(format!("basis `{basis}` at mu = {mu}")))?;
-                ReducedOperator::new(op, b).map_err(core(format!("projection on `{basis}`")))
-            })();
+            let built = reduced_operator(registry, basis, &p, op, mu, opts, stages, &params);
             let setup_s = t.elapsed().as_secs_f64();
             let setup_peak = meter.peak_mb();
             let red = match built {
@@ -690,6 +660,54 @@ pub fn bench_case(
         }
     }
     Ok((ref_out, runs))
+}
+
+/// The eigen solver plugin `name`.
+fn eigen_solver(registry: &Registry, name: &str) -> Result<Box<dyn EigenSolver>> {
+    registry
+        .eigen
+        .create(name, &Params::new())
+        .map_err(core(format!("eigen solver `{name}`")))
+}
+
+/// Builds basis `basis` with parameters `p` on `op` at `mu` (its model stage from
+/// `stages`, if it has one) and projects `op` on it.
+#[allow(clippy::too_many_arguments)]
+fn reduced_operator(
+    registry: &Registry,
+    basis: &str,
+    p: &Params,
+    op: &FrictionalOperator,
+    mu: f64,
+    opts: &BenchOptions,
+    stages: &Stages,
+    params: &EigenParams,
+) -> Result<ReducedOperator> {
+    let create = |name: &str| eigen_solver(registry, name);
+    let plugin = registry
+        .bases
+        .create(basis, p)
+        .map_err(core(format!("basis `{basis}`")))?;
+    let modal = create(&opts.modal)?;
+    let dense = create("dense")?;
+    let stage = plugin.stage_key(opts.band_hz[1]).and_then(|key| {
+        stages
+            .iter()
+            .find(|s| s.key == key)
+            .map(|s| s.stage.as_ref())
+    });
+    let req = BasisRequest {
+        op,
+        mu,
+        band_hz: (opts.band_hz[0], opts.band_hz[1]),
+        modal: modal.as_ref(),
+        reduced: dense.as_ref(),
+        params,
+        stage,
+    };
+    let b = squeal_core::contact::build_basis(plugin.as_ref(), &req)
+        .map_err(core(format!("basis `{basis}` at mu = {mu}")))?;
+    ReducedOperator::new(op, b).map_err(core(format!("projection on `{basis}`")))
 }
 
 /// Adds condition numbers to full-order `modes` when `opts.condition` asks for them and
