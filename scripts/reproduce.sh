@@ -11,6 +11,8 @@
 #                   off-centre zones
 #   meso-c2         mesoscopic plateaus in the coupling-2 region (0.2 mm grid)
 #   meso-c1         mesoscopic plateaus in the coupling-1 region (0.5 mm grid)
+#   fraction        the unstable share against the fraction of patches in contact, both
+#                   couplings, one patch size each (1 mm and 2 mm), 10 layouts per fraction
 #   bench           every basis x eigen solver at mu 0.3 and 0.7 against full order
 #   stress          the stress set (cases built to break methods)
 #
@@ -47,6 +49,17 @@ case "$name" in
     [ -d out/meso-c1 ] && resume=(--resume)
     $squeal sweep meso scenes/pin-on-disc-meso-c1.toml --coupling 1 --basis cms --jobs 2 \
       --out out/meso-c1 "${resume[@]}" "$@" ;;
+  fraction)
+    for f in 0.5 0.6 0.7 0.8; do
+      for c in 2 1; do
+        if [ $c = 2 ]; then scene=scenes/pin-on-disc-meso.toml; patch=0.001
+        else scene=scenes/pin-on-disc-meso-c1.toml; patch=0.002; fi
+        resume=()
+        [ -d out/fraction-c$c/f$f ] && resume=(--resume)
+        $squeal sweep meso $scene --coupling $c --patch $patch --layouts 10 --fraction $f \
+          --basis cms --no-charts --out out/fraction-c$c/f$f "${resume[@]}" "$@"
+      done
+    done ;;
   bench)
     $squeal bench pin-on-disc --mu 0.3,0.7 --out out/bench "$@" ;;
   stress)

@@ -21,11 +21,13 @@ pub const PAPER_PATCHES_COUPLING_2: &str = "0.0004,0.0006,0.0008,0.0010,0.0012,0
 /// The paper's patch sides (m), `paper-data.toml` `[mesoscopic.coupling_1]` (3500 Hz).
 pub const PAPER_PATCHES_COUPLING_1: &str = "0.0005,0.0010,0.0015,0.0020,0.0025,0.0030,0.0035";
 /// Region cut into patches for coupling 2 (m from the face corner): the paper gives no
-/// numbers, only "medium rectangular zones near the leading edge" (section 3.1): a
-/// 10 x 14 mm rectangle on the leading (+x) half, centred radially.
-pub const REGION_COUPLING_2: &str = "0.010,0.003,0.010,0.014";
-/// Region for coupling 1: "large, near-square zones around the centre": 14 x 14 mm, centred.
-pub const REGION_COUPLING_1: &str = "0.003,0.003,0.014,0.014";
+/// numbers, only "medium rectangular zones near the leading edge" (section 3.1). This is
+/// the default rig's own coupling-2 zone of the macro grid (`docs/results/macro-grid`,
+/// mu 0.36): 12 x 12 mm from x = 8 mm (the leading +x side), centred radially.
+pub const REGION_COUPLING_2: &str = "0.008,0.004,0.012,0.012";
+/// Region for coupling 1: "large, near-square zones around the centre"; on the default rig
+/// only zones that span the face in x give coupling 1 (macro grid): the whole face.
+pub const REGION_COUPLING_1: &str = "0,0,0.020,0.020";
 
 /// Options every study shares.
 #[derive(clap::Args)]
@@ -110,8 +112,8 @@ impl MacroArgs {
 pub struct MesoArgs {
     #[command(flatten)]
     scene: crate::opts::SceneArg,
-    /// Which coupling's defaults: 2 (2100 Hz: region 0.010,0.003,0.010,0.014, patches
-    /// 0.4-1.6 mm) or 1 (3500 Hz: region 0.003,0.003,0.014,0.014, patches 0.5-3.5 mm).
+    /// Which coupling's defaults: 2 (2100 Hz: region 0.008,0.004,0.012,0.012, patches
+    /// 0.4-1.6 mm) or 1 (3500 Hz: region 0,0,0.020,0.020, patches 0.5-3.5 mm).
     #[arg(long, default_value_t = 2)]
     coupling: u8,
     /// Region cut into patches, `x0,y0,a,b` (m from the pin face's corner).
@@ -123,8 +125,9 @@ pub struct MesoArgs {
     /// Random layouts per patch size.
     #[arg(long, default_value_t = 200)]
     layouts: usize,
-    /// Fraction of the patches in contact in each layout, in (0, 1].
-    #[arg(long, default_value_t = 0.5)]
+    /// Fraction of the patches in contact in each layout, in (0, 1] (the paper does not
+    /// give it; `docs/studies.md`).
+    #[arg(long, default_value_t = 0.7)]
     fraction: f64,
     /// Base seed of the layouts.
     #[arg(long, default_value_t = 1)]

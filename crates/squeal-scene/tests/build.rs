@@ -370,6 +370,35 @@ fn masks_and_plateaus_are_checked_and_reproducible() {
     let more = at(0.6).plateau_rectangles(size).unwrap();
     assert_eq!(more.len(), 60);
     assert!(a.iter().all(|r| more.contains(r)));
+    // each grid point belongs to one patch: the points in contact are the layout's
+    // fraction of the region's points, whatever the patch side (here a 0.5 mm grid)
+    let grid: Vec<[f64; 2]> = (0..41 * 41)
+        .map(|k| [(k % 41) as f64 * 0.0005, (k / 41) as f64 * 0.0005])
+        .collect();
+    for patch_m in [0.0005, 0.001, 0.0015, 0.002, 0.003, 0.0035] {
+        let z = squeal_scene::Zone::Plateaus {
+            patch_m,
+            seed: 3,
+            fraction: Some(0.6),
+            count: None,
+            region_m: None,
+        };
+        let on = z.select(&grid, size).iter().filter(|&&x| x).count();
+        let share = on as f64 / grid.len() as f64;
+        assert!(
+            (share - 0.6).abs() < 0.06,
+            "patch {patch_m}: {on} of {} points",
+            grid.len()
+        );
+        // and every point in contact lies in (or on the edge of) a patch in contact
+        let rects = z.plateau_rectangles(size).unwrap();
+        for (p, _) in grid.iter().zip(z.select(&grid, size)).filter(|(_, s)| *s) {
+            assert!(rects.iter().any(|r| p[0] >= r[0] - 1e-12
+                && p[0] <= r[0] + r[2] + 1e-12
+                && p[1] >= r[1] - 1e-12
+                && p[1] <= r[1] + r[3] + 1e-12));
+        }
+    }
     let mut bad = base.clone();
     bad.contact.zone = squeal_scene::Zone::Plateaus {
         patch_m: 0.05,

@@ -60,9 +60,12 @@ pub enum Zone {
 
 impl Zone {
     /// Which of the points `xy` (m, relative to the pin face's corner, in grid order) lie
-    /// in the zone on a face of `size = [size_x, size_y]`: rectangles and plateaus include
-    /// their edges (to `1e-9` of the face size); a mask selects by index (`values[p] == 1`;
-    /// the caller checks its length). The one inside test of contact sets, studies and maps.
+    /// in the zone on a face of `size = [size_x, size_y]`: a rectangle includes its edges
+    /// (to `1e-9` of the face size); a point of a plateau region belongs to the one patch
+    /// whose cell `[x, x + p) x [y, y + p)` holds it (the region's far edges closed), so the
+    /// pairs in contact are the layout's fraction of the region's pairs whatever the patch
+    /// side; a mask selects by index (`values[p] == 1`; the caller checks its length). The
+    /// one inside test of contact sets, studies and maps.
     pub fn select(&self, xy: &[[f64; 2]], size: [f64; 2]) -> Vec<bool> {
         let eps = 1e-9 * (size[0] + size[1]);
         let in_rect = |p: &[f64; 2], r: &[f64; 4]| -> bool {
@@ -71,7 +74,7 @@ impl Zone {
                 && p[1] >= r[1] - eps
                 && p[1] <= r[1] + r[3] + eps
         };
-        let plateaus = self.plateau_rectangles(size);
+        let plateaus = self.plateau_layout(size);
         xy.iter()
             .enumerate()
             .map(|(i, p)| match self {
@@ -82,9 +85,7 @@ impl Zone {
                     a_m,
                     b_m,
                 } => in_rect(p, &[*x0_m, *y0_m, *a_m, *b_m]),
-                Zone::Plateaus { .. } => plateaus
-                    .as_ref()
-                    .is_some_and(|rs| rs.iter().any(|r| in_rect(p, r))),
+                Zone::Plateaus { .. } => plateaus.as_ref().is_some_and(|l| l.holds(p, eps)),
                 Zone::Mask { values, .. } => values.as_ref().is_some_and(|v| v.get(i) == Some(&1)),
             })
             .collect()
@@ -93,6 +94,11 @@ impl Zone {
     /// The rectangles `[x0, y0, a, b]` (m, from the pin face's corner) of a plateau
     /// layout on a face of `size = [size_x, size_y]`; `None` for other zones.
     pub fn plateau_rectangles(&self, size: [f64; 2]) -> Option<Vec<[f64; 4]>> {
+        self.plateau_layout(size).map(|l| l.rectangles())
+    }
+
+    /// The patches of a plateau layout on a face of `size`, and which are in contact.
+    fn plateau_layout(&self, size: [f64; 2]) -> Option<PlateauLayout> {
         let Zone::Plateaus {
             patch_m,
             seed,
@@ -129,15 +135,58 @@ impl Zone {
         }
         let mut chosen: Vec<usize> = idx[..want].to_vec();
         chosen.sort_unstable();
-        Some(
-            chosen
-                .iter()
-                .map(|&k| {
-                    let (i, j) = (k % nx, k / nx);
-                    [x0 + i as f64 * px, y0 + j as f64 * py, px, py]
-                })
-                .collect(),
-        )
+        Some(PlateauLayout {
+            origin: [x0, y0],
+            patch: [px, py],
+            count: [nx, ny],
+            chosen,
+        })
+    }
+}
+
+/// A plateau layout: the region cut into `count` patches of side `patch` from `origin`
+/// (m), and the indices (row by row along x) of those in contact, increasing.
+struct PlateauLayout {
+    origin: [f64; 2],
+    patch: [f64; 2],
+    count: [usize; 2],
+    chosen: Vec<usize>,
+}
+
+impl PlateauLayout {
+    /// The rectangles `[x0, y0, a, b]` of the patches in contact.
+    fn rectangles(&self) -> Vec<[f64; 4]> {
+        self.chosen
+            .iter()
+            .map(|&k| {
+                let (i, j) = (k % self.count[0], k / self.count[0]);
+                [
+                    self.origin[0] + i as f64 * self.patch[0],
+                    self.origin[1] + j as f64 * self.patch[1],
+                    self.patch[0],
+                    self.patch[1],
+                ]
+            })
+            .collect()
+    }
+
+    /// Whether point `p` lies in a patch in contact: the patch whose half-open cell holds
+    /// it, the region's far edges included (`eps`: the tolerance of the region's edges).
+    fn holds(&self, p: &[f64; 2], eps: f64) -> bool {
+        let cell = |d: usize| -> Option<usize> {
+            let t = (p[d] - self.origin[d]) / self.patch[d];
+            let n = self.count[d];
+            let end = self.patch[d] * n as f64;
+            if p[d] < self.origin[d] - eps || p[d] > self.origin[d] + end + eps {
+                return None;
+            }
+            // a point on a patch boundary (to round-off) belongs to the patch it starts
+            Some(((t + 1e-6).floor().max(0.0) as usize).min(n - 1))
+        };
+        match (cell(0), cell(1)) {
+            (Some(i), Some(j)) => self.chosen.binary_search(&(j * self.count[0] + i)).is_ok(),
+            _ => false,
+        }
     }
 }
 
