@@ -88,26 +88,8 @@ impl ValidateArgs {
             .filter(|b| *b != "none")
             .cloned()
             .collect();
-        for b in std::iter::once(&self.figure_basis).chain(&checks) {
-            registry
-                .bases
-                .create(b, &squeal_core::Params::new())
-                .map_err(|e| anyhow::anyhow!("--figure-basis/--bases {b}: {e}"))?;
-        }
-        let on_grid = |mu: f64, step: f64| ((mu / step) - (mu / step).round()).abs() < 1e-6;
         for &mu in &self.reference_mu {
             crate::opts::check_mu("--reference-mu", mu)?;
-            if !(mu <= 0.8
-                && on_grid(mu, self.step)
-                && (checks.is_empty() || on_grid(mu, self.check_step)))
-            {
-                anyhow::bail!(
-                    "--reference-mu {mu}: expected a point of every sweep (0 to 0.8, multiples of \
-                     --step {} and --check-step {})",
-                    self.step,
-                    self.check_step
-                );
-            }
         }
         let settings = ValidateSettings {
             sweeps: std::iter::once((self.figure_basis.clone(), self.step))
@@ -118,7 +100,22 @@ impl ValidateArgs {
             eigen: self.eigen.clone(),
             resume: self.resume,
         };
-        squeal_analysis::validate::check(registry, &settings)?;
+        squeal_analysis::validate::check(registry, &settings).map_err(|e| match e {
+            // the library names the settings' fields; here they are options
+            RunError::Input { field, message } => {
+                let flag = match field.as_str() {
+                    "sweeps[0].basis" => "--figure-basis",
+                    f if f.ends_with(".basis") => "--bases",
+                    "sweeps[0].step" => "--step",
+                    f if f.ends_with(".step") => "--check-step",
+                    "reference_mu" => "--reference-mu",
+                    "eigen" => "--eigen",
+                    other => other,
+                };
+                anyhow::anyhow!("{flag} {message}")
+            }
+            e => e.into(),
+        })?;
         run(registry, self.scene.as_deref(), &self.out, &settings)
     }
 }

@@ -168,7 +168,8 @@ pub fn check(registry: &Registry, s: &ValidateSettings) -> Result<(), RunError> 
         squeal_contact::check_user_mu(mu)
             .map_err(|e| RunError::input("reference_mu", format!("{mu}: {e}")))?;
         if !(mu <= 0.8 && s.sweeps.iter().all(|(_, step)| on_grid(mu, *step))) {
-            let steps: Vec<String> = s.sweeps.iter().map(|(_, st)| st.to_string()).collect();
+            let mut steps: Vec<String> = s.sweeps.iter().map(|(_, st)| st.to_string()).collect();
+            steps.dedup();
             return Err(RunError::input(
                 "reference_mu",
                 format!(
