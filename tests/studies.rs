@@ -353,3 +353,61 @@ fn bad_inputs_are_errors_naming_the_option() {
         let _ = std::fs::remove_dir_all(d);
     }
 }
+
+#[test]
+fn a_meso_study_resumed_with_more_layouts_equals_one_run_with_them() {
+    let f = fixture();
+    let three = meso_def(&f);
+    let mut five = three.clone();
+    if let StudySpec::Meso(m) = &mut five.study {
+        m.layouts = 5;
+    }
+    let grown = tmp("grown");
+    let r = run(&f, &three, &grown, RunOptions::default());
+    assert_eq!(r.computed, r.cases);
+    let resume = RunOptions {
+        resume: true,
+        ..RunOptions::default()
+    };
+    let r = run(&f, &five, &grown, resume.clone());
+    assert_eq!(
+        r.resumed,
+        2 * 3,
+        "the three layouts of each patch size are kept"
+    );
+    assert_eq!(r.computed, 2 * 2);
+    let fresh = tmp("fresh5");
+    run(&f, &five, &fresh, RunOptions::default());
+    assert_same(&fresh, &grown);
+    // fewer layouts, or another change, is still another study
+    let e = study::run(
+        &f.reg,
+        &f.model,
+        &three,
+        &StudyDir::new(&grown),
+        &resume,
+        &|_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("written for another study"), "{e}");
+    let mut other = five.clone();
+    if let StudySpec::Meso(m) = &mut other.study {
+        m.layouts = 7;
+        m.seed = 12;
+    }
+    let e = study::run(
+        &f.reg,
+        &f.model,
+        &other,
+        &StudyDir::new(&grown),
+        &resume,
+        &|_| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("written for another study"), "{e}");
+    for d in [grown, fresh] {
+        let _ = std::fs::remove_dir_all(d);
+    }
+}

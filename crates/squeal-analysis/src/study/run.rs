@@ -230,7 +230,8 @@ pub struct RunReport {
     pub profile: Profile,
 }
 
-/// Writes `study.json`, or checks an existing one is the same study.
+/// Writes `study.json`, or checks an existing one is the same study (or, on resume, the
+/// same meso study with fewer layouts per patch size: it is extended).
 fn claim(dir: &StudyDir, def: &StudyDef, resume: bool) -> Result<()> {
     std::fs::create_dir_all(&dir.dir).map_err(|e| files(&dir.dir, e))?;
     let has_results = std::fs::metadata(dir.results()).is_ok_and(|m| m.len() > 0);
@@ -246,6 +247,12 @@ fn claim(dir: &StudyDir, def: &StudyDef, resume: bool) -> Result<()> {
     let want = serde_json::to_value(def).map_err(|e| files(&dir.study(), e))?;
     if dir.study().exists() {
         let have = serde_json::to_value(dir.read_def()?).map_err(|e| files(&dir.study(), e))?;
+        if resume && extends_layouts(&have, &want) {
+            // more layouts per patch size: the layouts done keep their ids and results
+            let text = serde_json::to_string_pretty(&want).map_err(|e| files(&dir.study(), e))?;
+            return jsonl::write_atomic(&dir.study(), text.as_bytes())
+                .map_err(|e| files(&dir.study(), e));
+        }
         if have != want {
             return Err(files(
                 &dir.study(),
@@ -259,6 +266,18 @@ fn claim(dir: &StudyDir, def: &StudyDef, resume: bool) -> Result<()> {
     }
     let text = serde_json::to_string_pretty(&want).map_err(|e| files(&dir.study(), e))?;
     jsonl::write_atomic(&dir.study(), text.as_bytes()).map_err(|e| files(&dir.study(), e))
+}
+
+/// Whether study `want` is study `have` with more layouts per patch size and nothing else
+/// changed (a meso study extended on resume).
+fn extends_layouts(have: &serde_json::Value, want: &serde_json::Value) -> bool {
+    let layouts = |v: &serde_json::Value| v["study"]["layouts"].as_u64();
+    let (Some(h), Some(w)) = (layouts(have), layouts(want)) else {
+        return false;
+    };
+    let mut same = have.clone();
+    same["study"]["layouts"] = w.into();
+    w > h && &same == want
 }
 
 /// What [`run`] tells its observer.
