@@ -380,32 +380,26 @@ fn a_meso_study_resumed_with_more_layouts_equals_one_run_with_them() {
     run(&f, &five, &fresh, RunOptions::default());
     assert_same(&fresh, &grown);
     // fewer layouts, or another change, is still another study
-    let e = study::run(
-        &f.reg,
-        &f.model,
-        &three,
-        &StudyDir::new(&grown),
-        &resume,
-        &|_| {},
-    )
-    .unwrap_err()
-    .to_string();
+    let refused = |def: &StudyDef| {
+        study::run(
+            &f.reg,
+            &f.model,
+            def,
+            &StudyDir::new(&grown),
+            &resume,
+            &|_| {},
+        )
+        .unwrap_err()
+        .to_string()
+    };
+    let e = refused(&three);
     assert!(e.contains("written for another study"), "{e}");
     let mut other = five.clone();
     if let StudySpec::Meso(m) = &mut other.study {
         m.layouts = 7;
         m.seed = 12;
     }
-    let e = study::run(
-        &f.reg,
-        &f.model,
-        &other,
-        &StudyDir::new(&grown),
-        &resume,
-        &|_| {},
-    )
-    .unwrap_err()
-    .to_string();
+    let e = refused(&other);
     assert!(e.contains("written for another study"), "{e}");
     for d in [grown, fresh] {
         let _ = std::fs::remove_dir_all(d);
