@@ -50,7 +50,9 @@ case "$name" in
     $squeal sweep meso scenes/pin-on-disc-meso-c1.toml --coupling 1 --basis cms --jobs 2 \
       --out out/meso-c1 "${resume[@]}" "$@" ;;
   fraction)
-    for f in 0.5 0.6 0.7 0.8; do
+    # 0.7 is the meso studies' fraction: their first 10 layouts of 1 mm (coupling 2) and
+    # 2 mm (coupling 1) are these layouts at 0.7 (the layouts are nested across fractions)
+    for f in 0.3 0.4 0.5 0.6 0.8; do
       for c in 2 1; do
         if [ $c = 2 ]; then scene=scenes/pin-on-disc-meso.toml; patch=0.001
         else scene=scenes/pin-on-disc-meso-c1.toml; patch=0.002; fi
