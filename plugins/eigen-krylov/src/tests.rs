@@ -3,6 +3,7 @@
 use super::*;
 use squeal_core::eigen::dense_symmetric;
 use squeal_core::faer::sparse::Triplet;
+use squeal_core::faer::Mat;
 use squeal_core::{SparseMat, StopReason};
 use std::f64::consts::PI;
 
