@@ -1,6 +1,9 @@
 //! Tests of the complex Krylov-Schur kernel on operators with a known spectrum.
 
 use super::*;
+use squeal_core::faer::linalg::matmul::matmul;
+use squeal_core::faer::linalg::solvers::Solve;
+use squeal_core::faer::{Accum, MatMut, MatRef};
 use std::time::Instant;
 
 /// Deterministic uniform numbers in `[-1, 1)` (SplitMix64).
