@@ -2,14 +2,13 @@
 //! against the full-order reference, and the stress set (`--stress`).
 
 use anyhow::{Context, Result};
-use serde::Serialize;
 use squeal_analysis::bench::{
-    run_suite, BenchOptions, BenchRun, BenchSource, MemoryProbe, SuiteEvent, SuiteSettings,
+    bound_threshold, run_suite, stress_rows, Accuracy, BenchOptions, BenchRun, BenchSource,
+    MemoryProbe, StressRow, SuiteEvent, SuiteSettings,
 };
 use squeal_analysis::outdir::RunError;
 use squeal_analysis::pipeline::Prepared;
 use squeal_core::Registry;
-use squeal_plot::{line_chart, pareto_chart, ChartOptions, Series, SeriesStyle};
 use std::path::{Path, PathBuf};
 
 /// The counting allocator of the binary, as a [`MemoryProbe`].
@@ -245,7 +244,7 @@ pub fn replot(out: &Path, stress: bool) -> Result<()> {
     let files = if stress {
         stress_report(out, &runs)?
     } else {
-        charts(out, &runs)?
+        crate::bench_charts::charts(out, &runs)?
     };
     println!("redrew {} files in {}", files.len(), out.display());
     Ok(())
@@ -324,7 +323,7 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
             if a.stress {
                 stress_report(a.out, runs)
             } else {
-                charts(a.out, runs)
+                crate::bench_charts::charts(a.out, runs)
             }
             .map_err(|e| RunError::Output(format!("{e:#}")))
         },
@@ -357,176 +356,6 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
     Ok(())
 }
 
-fn label(r: &BenchRun) -> String {
-    if r.basis_opts.is_empty() {
-        format!("{}/{}", r.basis, r.eigen)
-    } else {
-        format!("{} [{}]/{}", r.basis, r.basis_opts, r.eigen)
-    }
-}
-
-/// Chart points `(label, time, error)`: the runs of one basis variant whose errors agree
-/// to 1 % (the eigen solvers of one reduced problem do, to a few digits) become one point
-/// at the fastest time, labelled `basis [opts]/fastest (~ others)`, so labels do not
-/// overlap on the log axes.
-fn merged_points(
-    runs: &[&BenchRun],
-    err: fn(&BenchRun) -> f64,
-    time: fn(&BenchRun) -> f64,
-) -> Vec<(String, f64, f64)> {
-    let mut groups: Vec<Vec<&BenchRun>> = Vec::new();
-    for r in runs.iter().filter(|r| err(r).is_finite()) {
-        let same = |g: &Vec<&BenchRun>| {
-            let h = g[0];
-            h.basis == r.basis
-                && h.basis_opts == r.basis_opts
-                && (err(h) - err(r)).abs() <= 1e-2 * err(h).abs().max(err(r).abs())
-        };
-        match groups.iter_mut().find(|g| same(g)) {
-            Some(g) => g.push(r),
-            None => groups.push(vec![r]),
-        }
-    }
-    groups
-        .into_iter()
-        .map(|mut g| {
-            g.sort_by(|a, b| time(a).total_cmp(&time(b)));
-            let mut name = label(g[0]);
-            if g.len() > 1 {
-                let others: Vec<&str> = g[1..].iter().map(|r| r.eigen.as_str()).collect();
-                name.push_str(&format!(" (~ {})", others.join(", ")));
-            }
-            (name, time(g[0]), err(g[0]))
-        })
-        .collect()
-}
-
-/// Error-vs-size series (named `basis/eigen`) of one basis whose points agree (same
-/// sizes, errors to 1 %: the eigen solvers of one reduced problem) become one series
-/// named `basis/first (~ others)`, so no line hides under another of a different colour.
-fn merged_series(series: Vec<Series>) -> Vec<Series> {
-    let basis = |s: &Series| s.name.split('/').next().unwrap_or("").to_string();
-    let same = |a: &Series, b: &Series| {
-        basis(a) == basis(b)
-            && a.points.len() == b.points.len()
-            && a.points
-                .iter()
-                .zip(&b.points)
-                .all(|(p, q)| p.0 == q.0 && (p.1 - q.1).abs() <= 1e-2 * p.1.abs().max(q.1.abs()))
-    };
-    let mut out: Vec<(Series, Vec<String>)> = Vec::new();
-    for s in series {
-        match out.iter_mut().find(|(g, _)| same(g, &s)) {
-            Some((_, others)) => {
-                others.push(s.name.rsplit('/').next().unwrap_or("").to_string());
-            }
-            None => out.push((s, Vec::new())),
-        }
-    }
-    out.into_iter()
-        .map(|(mut s, others)| {
-            if !others.is_empty() {
-                s.name.push_str(&format!(" (~ {})", others.join(", ")));
-            }
-            s
-        })
-        .collect()
-}
-
-/// Error vs time (total, and per mu with the basis reused; Pareto front marked) and
-/// error vs basis size, per case.
-fn charts(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
-    let mut files = Vec::new();
-    let mut cases: Vec<&str> = runs.iter().map(|r| r.case.as_str()).collect();
-    cases.dedup();
-    for case in cases {
-        let ok: Vec<&BenchRun> = runs
-            .iter()
-            .filter(|r| r.case == case && r.status == "ok" && !r.reference)
-            .collect();
-        let tag = case.replace('=', "");
-        let ref_time = runs
-            .iter()
-            .find(|r| r.case == case && r.reference)
-            .map_or(f64::NAN, |r| r.solve_s);
-        for (what, key, err) in [
-            (
-                "max relative frequency error",
-                "freq",
-                (|r: &BenchRun| r.errors.max_rel_freq_err) as fn(&BenchRun) -> f64,
-            ),
-            ("max |DvR error|", "dvr", |r: &BenchRun| {
-                r.errors.max_abs_dvr_err
-            }),
-        ] {
-            for (stem, stem_title, axis, time) in [
-                (
-                    "time",
-                    "total time",
-                    "time (setup + solve)",
-                    (|r: &BenchRun| r.time_s) as fn(&BenchRun) -> f64,
-                ),
-                (
-                    "solve_time",
-                    "per-mu time",
-                    "per-mu solve time, basis reused",
-                    |r: &BenchRun| r.solve_s,
-                ),
-            ] {
-                let pts = merged_points(&ok, err, time);
-                if pts.iter().any(|p| p.1 > 0.0 && p.2 > 0.0) {
-                    files.extend(pareto_chart(
-                        &out.join(format!("{key}_error_vs_{stem}_{tag}")),
-                        &format!("{case}: {what} vs {stem_title} (reference {ref_time:.1} s)"),
-                        &format!("{axis} (s)"),
-                        what,
-                        &pts,
-                    )?);
-                }
-            }
-        }
-        // error vs basis size, one series per basis/eigen
-        let mut series: Vec<Series> = Vec::new();
-        for r in ok.iter().filter(|r| r.basis != "none") {
-            let name = format!("{}/{}", r.basis, r.eigen);
-            let p = (r.basis_size as f64, r.errors.max_rel_freq_err);
-            if !p.1.is_finite() {
-                continue;
-            }
-            match series.iter_mut().find(|s| s.name == name) {
-                Some(s) => s.points.push(p),
-                None => series.push(Series {
-                    name,
-                    points: vec![p],
-                    style: SeriesStyle::LineMarkers,
-                    highlight: Vec::new(),
-                }),
-            }
-        }
-        for s in &mut series {
-            s.points.sort_by(|a, b| a.0.total_cmp(&b.0));
-        }
-        let series = merged_series(series);
-        if series
-            .iter()
-            .any(|s| s.points.iter().any(|p| p.0 > 0.0 && p.1 > 0.0))
-        {
-            files.extend(line_chart(
-                &out.join(format!("error_vs_size_{tag}")),
-                &format!("{case}: max relative frequency error vs basis size"),
-                "basis size (vectors)",
-                "max relative frequency error",
-                &series,
-                &ChartOptions {
-                    log_y: true,
-                    ..ChartOptions::default()
-                },
-            )?);
-        }
-    }
-    Ok(files)
-}
-
 /// The stress table: per case and method, whether it is wrong; whether its own error
 /// estimate (the worst backward error) rose against the baseline case; its worst
 /// condition number and forward error estimate (`error_bound`), and, where it is wrong,
@@ -535,84 +364,8 @@ fn charts(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
 /// ([`bound_threshold`]). Printed, and written to `stress-table.txt` and
 /// `stress-table.json`.
 fn stress_report(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
-    #[derive(Serialize)]
-    struct Row {
-        case: String,
-        method: String,
-        basis_opts: String,
-        wrong: bool,
-        why: Vec<String>,
-        max_backward_error: f64,
-        baseline_backward_error: f64,
-        estimate_ratio: f64,
-        flagged: bool,
-        /// Worst condition number of the case's modes (null: not computed).
-        cond: f64,
-        /// Worst forward error estimate of the case's modes (null: not computed).
-        error_bound: f64,
-        /// The actual worst relative eigenvalue error of the matched modes.
-        actual_error: f64,
-        /// Matched modes whose actual error exceeds their own bound.
-        above_bound: usize,
-        /// For a wrong run with bounds: whether the bound flagged it (null otherwise).
-        bound_flagged: Option<bool>,
-        /// The method stopped with an error (e.g. `dense` refusing a full-order problem
-        /// above its `max_dim`): no answer, so neither right nor wrong.
-        failed: bool,
-    }
-    let acc = squeal_analysis::bench::Accuracy::default();
-    let threshold = bound_threshold(&acc);
-    let base = |r: &BenchRun| -> f64 {
-        runs.iter()
-            .find(|b| b.case == "baseline" && b.basis == r.basis && b.eigen == r.eigen)
-            .map_or(f64::NAN, |b| b.errors.max_backward_error)
-    };
-    let mut rows = Vec::new();
-    for r in runs.iter().filter(|r| !r.reference) {
-        let mut why = Vec::new();
-        if r.status != "ok" {
-            why.push(r.status.clone());
-        } else {
-            let e = &r.errors;
-            if e.missed_modes > 0 {
-                why.push(format!("{} modes missed", e.missed_modes));
-            }
-            if e.missed_unstable > 0 {
-                why.push(format!("{} unstable modes missed", e.missed_unstable));
-            }
-            if e.false_unstable > 0 {
-                why.push(format!("{} false unstable", e.false_unstable));
-            }
-            if e.max_rel_freq_err > acc.freq_rel {
-                why.push(format!("df/f {:.1e}", e.max_rel_freq_err));
-            }
-            if e.max_abs_dvr_err > acc.dvr_abs {
-                why.push(format!("dDvR {:.1e}", e.max_abs_dvr_err));
-            }
-        }
-        let b = base(r);
-        let ratio = r.errors.max_backward_error / b;
-        let wrong = r.status == "ok" && !why.is_empty();
-        let e = &r.errors;
-        rows.push(Row {
-            case: r.case.clone(),
-            method: format!("{}/{}", r.basis, r.eigen),
-            basis_opts: r.basis_opts.clone(),
-            wrong,
-            failed: r.status != "ok",
-            why,
-            max_backward_error: e.max_backward_error,
-            baseline_backward_error: b,
-            estimate_ratio: ratio,
-            flagged: ratio >= 10.0,
-            cond: e.max_cond,
-            error_bound: e.max_error_bound,
-            actual_error: e.max_rel_lambda_err,
-            above_bound: e.above_bound,
-            bound_flagged: (wrong && !e.max_error_bound.is_nan())
-                .then(|| bound_flags(e, threshold)),
-        });
-    }
+    let threshold = bound_threshold(&Accuracy::default());
+    let rows = stress_rows(runs);
     let mut text = format!(
         "stress set: where each method is wrong; whether its backward error rose >= 10x over \
          the baseline case (flagged); its worst cond and error_bound (relative eigenvalue \
@@ -676,7 +429,7 @@ fn stress_report(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
         .iter()
         .filter(|r| r.wrong && r.bound_flagged.is_none())
         .count();
-    let accurate: Vec<&Row> = rows.iter().filter(|r| !r.wrong && !r.failed).collect();
+    let accurate: Vec<&StressRow> = rows.iter().filter(|r| !r.wrong && !r.failed).collect();
     let alarms = accurate
         .iter()
         .filter(|r| r.error_bound > threshold)
@@ -702,25 +455,6 @@ fn stress_report(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
     Ok(vec![txt, path])
 }
 
-/// The forward error estimate above which a run cannot be trusted to be accurate: a
-/// relative eigenvalue error `e` moves the frequency by up to about `e` (relative) and
-/// the DvR by up to about `e` (absolute), so the smaller of the two accuracy bounds.
-pub fn bound_threshold(acc: &squeal_analysis::bench::Accuracy) -> f64 {
-    acc.freq_rel.min(acc.dvr_abs)
-}
-
-/// Whether a run's bounds flag its errors: every reference mode found, no extra mode
-/// (a bound cannot vouch for a mode it does not have, nor against a spurious one) and
-/// every matched mode's actual error within its own bound; or the worst bound above
-/// `threshold`.
-pub fn bound_flags(e: &squeal_analysis::bench::ModeErrors, threshold: f64) -> bool {
-    let covers = e.missed_modes == 0
-        && e.extra_modes == 0
-        && e.above_bound == 0
-        && e.max_error_bound.is_finite();
-    covers || e.max_error_bound > threshold
-}
-
 /// Parses `--vary key=v1,v2` options (`none` for no variant).
 pub fn parse_vary(items: &[String]) -> Result<Vec<(String, Vec<f64>)>> {
     let mut out = Vec::new();
@@ -743,8 +477,7 @@ pub fn parse_vary(items: &[String]) -> Result<Vec<(String, Vec<f64>)>> {
 
 #[cfg(test)]
 mod tests {
-    use super::{merged_series, times};
-    use squeal_plot::{Series, SeriesStyle};
+    use super::times;
 
     #[test]
     fn speed_ups_keep_two_significant_digits() {
@@ -763,27 +496,5 @@ mod tests {
         }
         assert_eq!(times(0.0), "-");
         assert_eq!(times(f64::NAN), "-");
-    }
-
-    #[test]
-    fn identical_size_series_merge_by_basis() {
-        let s = |name: &str, pts: &[(f64, f64)]| Series {
-            name: name.into(),
-            points: pts.to_vec(),
-            style: SeriesStyle::LineMarkers,
-            highlight: Vec::new(),
-        };
-        let merged = merged_series(vec![
-            s("cms/arpack", &[(30.0, 1e-6), (40.0, 2e-7)]),
-            s("cms/dense", &[(30.0, 1.001e-6), (40.0, 2e-7)]),
-            s("cms/krylov", &[(30.0, 1e-6), (40.0, 3e-7)]),
-            s("pod/arpack", &[(30.0, 1e-6), (40.0, 2e-7)]),
-        ]);
-        let names: Vec<&str> = merged.iter().map(|s| s.name.as_str()).collect();
-        assert_eq!(
-            names,
-            ["cms/arpack (~ dense)", "cms/krylov", "pod/arpack"],
-            "same basis and points merge; a different error or basis does not"
-        );
     }
 }

@@ -3,6 +3,7 @@
 //! [`opts`].
 
 mod bench;
+mod bench_charts;
 mod calibrate;
 mod equilibrium;
 mod modes;
