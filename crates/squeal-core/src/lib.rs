@@ -25,6 +25,7 @@ pub mod interop;
 pub mod linalg;
 pub mod lowrank;
 pub mod material;
+pub mod ordering;
 pub mod params;
 pub mod qep;
 pub mod reduction;

@@ -5,13 +5,18 @@
 //! `OP = (K - sigma M)^-1 M`. It is self-adjoint in the `M` inner product and its
 //! eigenvalues `theta = 1 / (lambda - sigma)` are largest for the `lambda` nearest
 //! `sigma`. With `sigma` below the spectrum, `K - sigma M` is positive definite and
-//! one sparse Cholesky factorization (faer, AMD ordering) serves every application.
+//! one sparse Cholesky factorization (faer supernodal, ordered by
+//! [`crate::ordering`]) serves every application.
 
+use crate::ordering::{symmetric_ordering, FillOrdering};
 use crate::{Error, Result, SparseMat, SparseRef};
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
+};
 use faer::sparse::Triplet;
-use faer::{Mat, MatMut, MatRef, Par, Side};
+use faer::{Conj, Mat, MatMut, MatRef, Par, Side};
 
 /// `alpha A + beta B` for square sparse matrices of the same size (patterns may differ).
 pub fn add_scaled(a: SparseRef<'_>, alpha: f64, b: SparseRef<'_>, beta: f64) -> Result<SparseMat> {
@@ -195,10 +200,84 @@ pub fn check_square_finite(a: SparseRef<'_>, n: usize, what: &str) -> Result<()>
     Ok(())
 }
 
+/// A sparse supernodal `A = L L^T` (faer) in the fill-reducing ordering of
+/// [`FillOrdering::of`]: the symbolic analysis and the values of `L`.
+struct SparseLlt {
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<f64>,
+}
+
+/// Why a [`SparseLlt`] failed: its symbolic analysis (and ordering), or its numeric
+/// factorization (the matrix is not positive definite).
+enum LltFailure {
+    Symbolic(String),
+    Numeric(String),
+}
+
+impl SparseLlt {
+    /// Orders, analyses and factorizes the lower triangle of `a`.
+    fn new(a: SparseRef<'_>) -> std::result::Result<Self, LltFailure> {
+        let ordering =
+            FillOrdering::of(a.symbolic()).map_err(|e| LltFailure::Symbolic(e.to_string()))?;
+        let symbolic = factorize_symbolic_cholesky(
+            a.symbolic(),
+            Side::Lower,
+            symmetric_ordering(ordering.as_ref()),
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| LltFailure::Symbolic(format!("{e:?}")))?;
+        let mut values = Vec::new();
+        values.try_reserve_exact(symbolic.len_val()).map_err(|_| {
+            LltFailure::Symbolic(format!(
+                "out of memory for {} entries of L",
+                symbolic.len_val()
+            ))
+        })?;
+        values.resize(symbolic.len_val(), 0.0);
+        let par = faer::get_global_parallelism();
+        let mut mem = MemBuffer::try_new(
+            symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
+        )
+        .map_err(|_| {
+            LltFailure::Symbolic("out of memory for the factorization's workspace".into())
+        })?;
+        symbolic
+            .factorize_numeric_llt(
+                &mut values,
+                a,
+                Side::Lower,
+                LltRegularization::default(),
+                par,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .map_err(|e| LltFailure::Numeric(format!("{e:?}")))?;
+        Ok(Self { symbolic, values })
+    }
+
+    /// Entries stored in `L`.
+    fn factor_entries(&self) -> usize {
+        self.symbolic.len_val()
+    }
+
+    /// `B <- A^-1 B`.
+    fn solve_in_place(&self, b: MatMut<'_, f64>) {
+        let par = faer::get_global_parallelism();
+        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(b.ncols(), par));
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            b,
+            par,
+            MemStack::new(&mut mem),
+        );
+    }
+}
+
 /// A sparse Cholesky factorization `A = L L^T` of a symmetric positive definite matrix
-/// (faer supernodal), solved against one or many right-hand sides.
+/// (faer supernodal, ordered by [`crate::ordering`]), solved against one or many
+/// right-hand sides.
 pub struct Cholesky {
-    llt: Llt<usize, f64>,
+    llt: SparseLlt,
     n: usize,
 }
 
@@ -207,16 +286,14 @@ impl Cholesky {
     pub fn new(a: SparseRef<'_>, what: &str) -> Result<Self> {
         let n = a.nrows();
         check_square_finite(a, n, what)?;
-        let fail = |reason: String| Error::Factorization {
+        let llt = SparseLlt::new(a).map_err(|f| Error::Factorization {
             what: format!("{what} (n = {n})"),
-            reason,
-        };
-        let symbolic =
-            SymbolicLlt::try_new(a.symbolic(), Side::Lower).map_err(|e| fail(format!("{e:?}")))?;
-        let llt = Llt::try_new_with_symbolic(symbolic, a, Side::Lower).map_err(|e| {
-            fail(format!(
-                "{e:?} (not positive definite: are the rigid-body motions restrained?)"
-            ))
+            reason: match f {
+                LltFailure::Symbolic(e) => e,
+                LltFailure::Numeric(e) => {
+                    format!("{e} (not positive definite: are the rigid-body motions restrained?)")
+                }
+            },
         })?;
         Ok(Self { llt, n })
     }
@@ -224,6 +301,11 @@ impl Cholesky {
     /// Size.
     pub fn dim(&self) -> usize {
         self.n
+    }
+
+    /// Entries stored in the factor `L`.
+    pub fn factor_entries(&self) -> usize {
+        self.llt.factor_entries()
     }
 
     /// `B <- A^-1 B` for a block of right-hand sides (columns).
@@ -243,7 +325,7 @@ impl Cholesky {
 pub struct ShiftInvert<'a> {
     m: SparseRef<'a>,
     sigma: f64,
-    llt: Llt<usize, f64>,
+    llt: SparseLlt,
     applications: std::sync::atomic::AtomicUsize,
 }
 
@@ -259,15 +341,13 @@ impl<'a> ShiftInvert<'a> {
             what: format!("K - sigma M (sigma = {sigma:.6e} (rad/s)^2, n = {n})"),
             reason,
         };
-        let symbolic = SymbolicLlt::try_new(shifted.symbolic(), Side::Lower)
-            .map_err(|e| fail(format!("{e:?}")))?;
-        let llt =
-            Llt::try_new_with_symbolic(symbolic, shifted.as_ref(), Side::Lower).map_err(|e| {
-                fail(format!(
-                    "{e:?} (not positive definite: is sigma below the lowest eigenvalue, \
-                     and are the rigid-body motions of K restrained or M positive?)"
-                ))
-            })?;
+        let llt = SparseLlt::new(shifted.as_ref()).map_err(|f| match f {
+            LltFailure::Symbolic(e) => fail(e),
+            LltFailure::Numeric(e) => fail(format!(
+                "{e} (not positive definite: is sigma below the lowest eigenvalue, \
+                 and are the rigid-body motions of K restrained or M positive?)"
+            )),
+        })?;
         Ok(Self {
             m,
             sigma,

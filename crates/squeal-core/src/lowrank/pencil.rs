@@ -2,9 +2,10 @@
 //! shift ([`SymmetricPencil`]).
 
 use crate::contact::FrictionalOperator;
+use crate::ordering::{symmetric_ordering, FillOrdering};
 use crate::{Error, Result, SparseMat, SparseRef};
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky,
 };
 use faer::sparse::linalg::{SupernodalThreshold, SymbolicSupernodalParams};
 use faer::sparse::{SymbolicSparseColMat, Triplet};
@@ -15,7 +16,8 @@ use faer::Side;
 pub const MAX_ASYMMETRY: f64 = 1e-10;
 
 /// Symbolic analysis of `S(s) = K_c - s M_c`, valid for every shift `s`: the lower
-/// triangle of the union pattern of `K_c`, `M_c` and the diagonal, the AMD ordering and
+/// triangle of the union pattern of `K_c`, `M_c` and the diagonal, its fill-reducing
+/// ordering ([`crate::ordering`]) and
 /// the supernodal structure of the factor. `K_c` and `M_c` are used symmetrized,
 /// `(X + X^T) / 2`; their measured asymmetry is kept in [`asymmetry`](Self::asymmetry).
 #[derive(Debug)]
@@ -94,10 +96,11 @@ impl SymmetricPencil {
                 asymmetry = asymmetry.max(diff / big);
             }
         }
+        let ordering = FillOrdering::of(pat)?;
         let chol = factorize_symbolic_cholesky(
             pat,
             Side::Lower,
-            SymmetricOrdering::Amd,
+            symmetric_ordering(ordering.as_ref()),
             CholeskySymbolicParams {
                 // Bunch-Kaufman pivoting exists only in the supernodal variant.
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
