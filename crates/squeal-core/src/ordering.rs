@@ -3,10 +3,11 @@
 //! Above [`NESTED_DISSECTION_MIN_DIM`] unknowns, every symmetric factorization (the
 //! Cholesky of `K - sigma M`, the `L B L^T` of the constrained pencil) is ordered by METIS
 //! nested dissection (`METIS_NodeND`, METIS 5 built from source by `metis-sys`); below it
-//! by faer's approximate minimum degree. On the default rig (171,963 DOFs, 12.1 M stored
-//! entries) nested dissection holds 91.5 M entries in `L` against 144.0 M with AMD, and the
-//! numeric Cholesky takes 3.6 s against 7.5 s on two cores (ordering 1.5 s, done once per
-//! pattern); on the coarse rig (1,779 DOFs) it gains nothing. METIS's default options
+//! by faer's approximate minimum degree. On the default rig's constrained pencil at
+//! mu = 0.7 (171,767 unknowns; the `notes` of `squeal stability --operator DIR --eigen
+//! arpack` on `squeal export --mu 0.7 --out DIR`) nested dissection leaves 100 M entries in
+//! `L` where AMD left 147 M, and the full-order solve is about 10 % faster with 12 % less
+//! memory; on the coarse rig (1,779 unknowns) it gains nothing. METIS's default options
 //! seed its random choices with a fixed value, so the ordering, and with it every result,
 //! is the same from run to run.
 

@@ -2,7 +2,8 @@
 //! interleaved, Dirichlet conditions and node ties by elimination.
 //!
 //! RCM (Cuthill & McKee 1969, George 1971) gives a small profile, so fill stays low for
-//! any factorization; faer's Cholesky further reorders with AMD. Eliminated DOFs are
+//! any factorization; the factorizations further reorder for fill
+//! (`squeal_core::ordering`). Eliminated DOFs are
 //! simply not numbered: the assembled matrices live on the free DOFs only.
 //!
 //! A [`Tie`] makes a node move as a weighted sum of other nodes (a hanging node of a fine
