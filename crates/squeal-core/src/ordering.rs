@@ -193,7 +193,9 @@ mod tests {
         let a = laplacian(30, 30, 24);
         let n = a.nrows();
         assert!(n >= NESTED_DISSECTION_MIN_DIM);
-        let nd = FillOrdering::of(a.symbolic()).unwrap().expect("nested dissection");
+        let nd = FillOrdering::of(a.symbolic())
+            .unwrap()
+            .expect("nested dissection");
         let mut seen = vec![false; n];
         for (new, &old) in nd.forward.iter().enumerate() {
             assert!(!seen[old] && nd.inverse[old] == new);
@@ -215,7 +217,9 @@ mod tests {
         chol.solve_vec_in_place(&mut x);
         let xm = Mat::from_fn(n, 1, |i, _| x[i]);
         let ax = &a * &xm;
-        let r = (0..n).map(|i| (ax[(i, 0)] - b[i]).abs()).fold(0.0, f64::max);
+        let r = (0..n)
+            .map(|i| (ax[(i, 0)] - b[i]).abs())
+            .fold(0.0, f64::max);
         let bmax = b.iter().map(|v| v.abs()).fold(0.0, f64::max);
         assert!(r < 1e-12 * bmax, "residual {r:e}");
     }

@@ -51,7 +51,7 @@ pub struct ModeErrors {
     /// Worst forward error estimate (`error_bound`, relative eigenvalue error) of the
     /// modes in the band; NaN when not computed (full order above
     /// [`CONDITION_AUTO_MAX_DIM`](squeal_core::qep::CONDITION_AUTO_MAX_DIM) DOFs without
-    /// [`BenchOptions::condition`]).
+    /// [`super::BenchOptions::condition`]).
     #[serde(default = "nan", deserialize_with = "null_as_nan")]
     pub max_error_bound: f64,
     /// Worst condition number of the modes in the band; NaN when not computed.

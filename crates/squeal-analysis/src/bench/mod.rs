@@ -22,7 +22,7 @@ mod compare;
 mod stress;
 mod suite;
 pub use case::{bench_case, BenchRun, ReferenceSolve};
-pub use compare::{compare, Accuracy, ModeErrors};
+pub use compare::{compare, Accuracy, ModeErrors, BOUND_FLOOR};
 pub use stress::{bound_flags, bound_threshold, stress_rows, StressRow};
 pub use suite::{
     run_suite, stress_cases, BenchSource, CaseInfo, StressCase, SuiteEvent, SuiteSettings,

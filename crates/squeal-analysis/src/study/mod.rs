@@ -13,7 +13,7 @@
 //! **Physics of a case.** Every pair of the zone is closed and sliding (no equilibrium
 //! solve): the contact set is built on the zone directly and the frictional operator on
 //! all its pairs, on a model built once for the whole study; the modes come from a
-//! [`Method`] (a reduction basis and an eigen solver, or full order).
+//! [`Method`](crate::pipeline::Method) (a reduction basis and an eigen solver, or full order).
 //!
 //! **Records.** Each finished case is appended at once to `results.jsonl` (one
 //! [`Record`] a line) and its wall times to `timings.jsonl` (one [`Timing`] a line): a

@@ -36,7 +36,7 @@ pub struct MesoSpec {
     pub layouts: usize,
     /// Fraction of the patches in contact, in (0, 1].
     pub fraction: f64,
-    /// Base seed; layout `l` of patch side `p` uses [`derive_seed`]`(seed, p in um, l)`,
+    /// Base seed; layout `l` of patch side `p` uses [`super::derive_seed`]`(seed, p in um, l)`,
     /// so a layout does not change when other patch sizes are added or removed.
     pub seed: u64,
 }

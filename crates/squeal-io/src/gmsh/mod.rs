@@ -31,12 +31,12 @@ mod write;
 
 use crate::IoError;
 use parse::{tokenize, Block, Parser};
-pub use write::{msh_string, write_msh, VOLUME_GROUP};
 use squeal_fe::mesh::hex_volume;
 use squeal_fe::Mesh;
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+pub use write::{msh_string, write_msh, VOLUME_GROUP};
 
 /// The expected format, quoted in errors.
 const EXPECTED_FORMAT: &str = "MSH 4.1 ASCII (`$MeshFormat` then `4.1 0 8`; \

@@ -33,7 +33,12 @@ pub(super) struct Parser<'a> {
 }
 
 impl<'a> Parser<'a> {
-    pub(super) fn err(&self, line: Option<usize>, problem: String, expected: impl Into<String>) -> IoError {
+    pub(super) fn err(
+        &self,
+        line: Option<usize>,
+        problem: String,
+        expected: impl Into<String>,
+    ) -> IoError {
         IoError::Msh {
             file: self.file.to_path_buf(),
             line,
@@ -140,7 +145,10 @@ impl Parser<'_> {
     }
 
     /// `$PhysicalNames` into `names` (by dimension and physical tag).
-    pub(super) fn physical_names(&mut self, names: &mut HashMap<(usize, i64), String>) -> Result<(), IoError> {
+    pub(super) fn physical_names(
+        &mut self,
+        names: &mut HashMap<(usize, i64), String>,
+    ) -> Result<(), IoError> {
         let (n, _) = self.count("the number of physical names")?;
         for _ in 0..n {
             let (dim, dline) = self.count("a physical dimension (0 to 3)")?;

@@ -460,5 +460,4 @@ impl ParametricOperator {
             t: None,
         })
     }
-
 }
