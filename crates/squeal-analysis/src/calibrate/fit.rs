@@ -16,15 +16,13 @@
 //! `tolerance` of it, or three rejected steps in a row (the radius shrunk 64-fold).
 
 use super::evaluate::{evaluate, Evaluation};
+use super::search::*;
 use super::spec::{CalibrationSpec, Method, Target};
 use crate::pipeline::{PipelineError, Result};
-use argmin::core::{
-    CostFunction, Error as ArgminError, Executor, Gradient, Hessian, IterState, Problem, Solver,
-    State, TerminationReason, TerminationStatus, KV,
-};
+use argmin::core::{Error as ArgminError, Executor, State};
 use argmin::solver::neldermead::NelderMead;
 use argmin::solver::trustregion::{Steihaug, TrustRegion};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use serde::Serialize;
 use squeal_core::Registry;
 use squeal_scene::Scene;
@@ -237,7 +235,11 @@ pub fn calibrate(
 /// The correction ratio of each target: its value on the scene's own rule over its value
 /// on the search's coarse rule (1 where that is not a finite positive number or the
 /// target does not scale).
-fn correction_ratios(fine: &Evaluation, coarse: &Evaluation, targets: &[Target]) -> Vec<f64> {
+pub(super) fn correction_ratios(
+    fine: &Evaluation,
+    coarse: &Evaluation,
+    targets: &[Target],
+) -> Vec<f64> {
     fine.measured
         .iter()
         .zip(&coarse.measured)
@@ -255,7 +257,7 @@ fn correction_ratios(fine: &Evaluation, coarse: &Evaluation, targets: &[Target])
 
 /// Runs the spec's search method from `z0` on `problem`: the best point argmin reports
 /// (if any) and why it stopped.
-fn run_search(
+pub(super) fn run_search(
     problem: SearchProblem<'_, '_>,
     spec: &CalibrationSpec,
     z0: DVector<f64>,
@@ -336,9 +338,9 @@ pub fn scene_at(
     Ok(scene.with_values(&set, file)?)
 }
 
-const BUDGET: &str = "calibration: evaluation budget used";
+pub(super) const BUDGET: &str = "calibration: evaluation budget used";
 
-fn search_error(e: &ArgminError) -> PipelineError {
+pub(super) fn search_error(e: &ArgminError) -> PipelineError {
     PipelineError::Core {
         stage: "calibration search".into(),
         source: squeal_core::Error::Invalid(e.to_string()),
@@ -347,7 +349,7 @@ fn search_error(e: &ArgminError) -> PipelineError {
 
 /// Search coordinates of `values`, kept 2 % of the range inside the bounds (where the
 /// map `u = (1 + sin z) / 2` still moves).
-fn to_z(spec: &CalibrationSpec, values: &[f64]) -> DVector<f64> {
+pub(super) fn to_z(spec: &CalibrationSpec, values: &[f64]) -> DVector<f64> {
     DVector::from_iterator(
         values.len(),
         spec.parameters
@@ -357,7 +359,7 @@ fn to_z(spec: &CalibrationSpec, values: &[f64]) -> DVector<f64> {
     )
 }
 
-fn to_values(spec: &CalibrationSpec, z: &DVector<f64>) -> Vec<f64> {
+pub(super) fn to_values(spec: &CalibrationSpec, z: &DVector<f64>) -> Vec<f64> {
     spec.parameters
         .iter()
         .zip(z.iter())
@@ -365,7 +367,7 @@ fn to_values(spec: &CalibrationSpec, z: &DVector<f64>) -> Vec<f64> {
         .collect()
 }
 
-fn step_of(
+pub(super) fn step_of(
     steps: &RefCell<Vec<Step>>,
     round: usize,
     kind: &str,
@@ -383,212 +385,5 @@ fn step_of(
         measured: e.measured.iter().map(|m| m.value).collect(),
         time_s: e.time_s,
         error: None,
-    }
-}
-
-type Recorder<'r> = dyn FnMut(Step) + 'r;
-
-/// An evaluated point of the search: `z` bits and weighted residuals (`None`: failed).
-type Cached = (Vec<u64>, Option<Vec<f64>>);
-
-/// The search on `z`: residuals of the cheap rule against the corrected targets.
-struct SearchProblem<'a, 'r> {
-    registry: &'a Registry,
-    spec: &'a CalibrationSpec,
-    scene: &'a Scene,
-    file: &'a str,
-    rule: &'a [(&'a str, f64)],
-    ratios: &'a [f64],
-    round: usize,
-    budget: usize,
-    used: RefCell<usize>,
-    /// Evaluated points: `z` bits and weighted residuals (`None`: failed).
-    cache: RefCell<Vec<Cached>>,
-    record: RefCell<&'r mut Recorder<'r>>,
-    steps: &'a RefCell<Vec<Step>>,
-}
-
-impl SearchProblem<'_, '_> {
-    /// Weighted residuals at `z` (`None` when the model failed there).
-    fn residuals(
-        &self,
-        z: &DVector<f64>,
-        kind: &str,
-    ) -> std::result::Result<Option<Vec<f64>>, ArgminError> {
-        let key: Vec<u64> = z.iter().map(|v| v.to_bits()).collect();
-        if let Some((_, r)) = self.cache.borrow().iter().find(|(k, _)| *k == key) {
-            return Ok(r.clone());
-        }
-        if *self.used.borrow() >= self.budget {
-            return Err(ArgminError::msg(BUDGET));
-        }
-        *self.used.borrow_mut() += 1;
-        let values = to_values(self.spec, z);
-        let t = Instant::now();
-        let result = scene_at(self.spec, self.scene, self.file, &values, self.rule).and_then(|s| {
-            evaluate(
-                self.registry,
-                &s,
-                self.file,
-                &self.spec.targets,
-                &self.spec.search,
-            )
-        });
-        let index = self.steps.borrow().len() + 1;
-        let (r, step) = match result {
-            Ok(e) => (
-                Some(e.weighted(&self.spec.targets, self.ratios)),
-                Step {
-                    index,
-                    round: self.round,
-                    kind: kind.into(),
-                    values,
-                    cost: e.cost(&self.spec.targets, self.ratios),
-                    measured: e.measured.iter().map(|m| m.value).collect(),
-                    time_s: e.time_s,
-                    error: None,
-                },
-            ),
-            Err(err) => (
-                None,
-                Step {
-                    index,
-                    round: self.round,
-                    kind: kind.into(),
-                    values,
-                    cost: f64::INFINITY,
-                    measured: vec![f64::NAN; self.spec.targets.len()],
-                    time_s: t.elapsed().as_secs_f64(),
-                    error: Some(err.to_string()),
-                },
-            ),
-        };
-        (self.record.borrow_mut())(step);
-        self.cache.borrow_mut().push((key, r.clone()));
-        Ok(r)
-    }
-
-    /// Forward-difference Jacobian of the weighted residuals in `z`, stepping inwards.
-    fn jacobian(
-        &self,
-        z: &DVector<f64>,
-    ) -> std::result::Result<(Vec<f64>, DMatrix<f64>), ArgminError> {
-        let r0 = self.residuals(z, "search")?.ok_or_else(|| {
-            ArgminError::msg("calibration: the model failed at the current point")
-        })?;
-        let h = 2.0 * self.spec.search.difference_step;
-        let mut jac = DMatrix::<f64>::zeros(r0.len(), z.len());
-        for j in 0..z.len() {
-            let mut zj = z.clone();
-            let step = if z[j] > 0.0 { -h } else { h };
-            zj[j] += step;
-            let rj = self.residuals(&zj, "jacobian")?.ok_or_else(|| {
-                ArgminError::msg(format!(
-                    "calibration: the model failed at a difference step of parameter {j}"
-                ))
-            })?;
-            for i in 0..r0.len() {
-                jac[(i, j)] = (rj[i] - r0[i]) / step;
-            }
-        }
-        Ok((r0, jac))
-    }
-}
-
-impl CostFunction for SearchProblem<'_, '_> {
-    type Param = DVector<f64>;
-    type Output = f64;
-    fn cost(&self, z: &DVector<f64>) -> std::result::Result<f64, ArgminError> {
-        Ok(self.residuals(z, "search")?.map_or(f64::INFINITY, |r| {
-            r.iter().map(|x| x * x).sum::<f64>() / 2.0
-        }))
-    }
-}
-
-impl Gradient for SearchProblem<'_, '_> {
-    type Param = DVector<f64>;
-    type Gradient = DVector<f64>;
-    fn gradient(&self, z: &DVector<f64>) -> std::result::Result<DVector<f64>, ArgminError> {
-        let (r, j) = self.jacobian(z)?;
-        Ok(j.transpose() * DVector::from_vec(r))
-    }
-}
-
-impl Hessian for SearchProblem<'_, '_> {
-    type Param = DVector<f64>;
-    type Hessian = DMatrix<f64>;
-    fn hessian(&self, z: &DVector<f64>) -> std::result::Result<DMatrix<f64>, ArgminError> {
-        let (_, j) = self.jacobian(z)?;
-        let mut h = j.transpose() * &j;
-        let scale = h.diagonal().max().max(1e-12);
-        for i in 0..h.nrows() {
-            h[(i, i)] += 1e-9 * scale;
-        }
-        Ok(h)
-    }
-}
-
-type TrState = IterState<DVector<f64>, DVector<f64>, (), DMatrix<f64>, (), f64>;
-
-/// argmin's trust region with the stopping rules of a model-updating search.
-struct Stalling<S> {
-    inner: S,
-    tolerance: f64,
-    last_cost: f64,
-    rejected: usize,
-}
-
-impl<O, S> Solver<O, TrState> for Stalling<S>
-where
-    S: Solver<O, TrState>,
-{
-    fn name(&self) -> &str {
-        "trust-region Gauss-Newton"
-    }
-
-    fn init(
-        &mut self,
-        problem: &mut Problem<O>,
-        state: TrState,
-    ) -> std::result::Result<(TrState, Option<KV>), ArgminError> {
-        let (state, kv) = self.inner.init(problem, state)?;
-        self.last_cost = state.get_cost();
-        Ok((state, kv))
-    }
-
-    fn next_iter(
-        &mut self,
-        problem: &mut Problem<O>,
-        state: TrState,
-    ) -> std::result::Result<(TrState, Option<KV>), ArgminError> {
-        let (state, kv) = self.inner.next_iter(problem, state)?;
-        let cost = state.get_cost();
-        if cost < self.last_cost {
-            self.rejected = 0;
-        } else {
-            self.rejected += 1;
-        }
-        Ok((state, kv))
-    }
-
-    fn terminate(&mut self, state: &TrState) -> TerminationStatus {
-        let cost = state.get_cost();
-        let out = if self.rejected >= 3 {
-            TerminationStatus::Terminated(TerminationReason::SolverExit(
-                "three rejected steps in a row".into(),
-            ))
-        } else if cost < self.last_cost && self.last_cost - cost < self.tolerance * self.last_cost {
-            TerminationStatus::Terminated(TerminationReason::SolverExit(
-                "the cost stopped falling".into(),
-            ))
-        } else if cost == 0.0 {
-            TerminationStatus::Terminated(TerminationReason::SolverExit("cost zero".into()))
-        } else {
-            TerminationStatus::NotTerminated
-        };
-        if cost < self.last_cost {
-            self.last_cost = cost;
-        }
-        out
     }
 }

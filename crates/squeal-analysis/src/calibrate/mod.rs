@@ -8,9 +8,12 @@
 //! The spec format is in `docs/calibrate.md`; [`spec`] reads and checks it, [`evaluate`](mod@evaluate)
 //! measures one scene, [`fit`] runs the search.
 
+mod check;
 pub mod evaluate;
 pub mod fit;
+mod search;
 pub mod spec;
+mod tied;
 
 pub use evaluate::{evaluate, Evaluation, Measured};
 pub use fit::{calibrate, scene_at, FitResult, Step};
