@@ -218,7 +218,21 @@ fn meso_charts(
     patches: &[f64],
     recs: &[&Record],
 ) -> Result<Vec<PathBuf>> {
-    let mut files = Vec::new();
+    let mut files = unstable_vs_patch(dir, def, mus, patches, recs)?;
+    files.extend(dvr_vs_freq(dir, patches, recs)?);
+    files.extend(trigger_and_suppress(dir, def, recs)?);
+    Ok(files)
+}
+
+/// Figure 22: the unstable share of the layouts against the patch size, overall and per
+/// class.
+fn unstable_vs_patch(
+    dir: &Path,
+    def: &StudyDef,
+    mus: &[f64],
+    patches: &[f64],
+    recs: &[&Record],
+) -> Result<Vec<PathBuf>> {
     // Figure 22: unstable fraction vs patch size, overall and per class
     let mut series = Vec::new();
     for &mu in mus {
@@ -255,7 +269,7 @@ fn meso_charts(
             }
         }
     }
-    files.extend(line_chart(
+    Ok(line_chart(
         &dir.join("unstable_fraction_vs_patch"),
         "Unstable layouts vs patch size",
         "patch side (mm)",
@@ -265,8 +279,11 @@ fn meso_charts(
             y_range: Some((0.0, 100.0)),
             ..ChartOptions::default()
         },
-    )?);
-    // Figures 20-21: DvR vs frequency of the unstable modes, one series per patch size
+    )?)
+}
+
+/// Figures 20-21: DvR against frequency of the unstable modes, one series per patch size.
+fn dvr_vs_freq(dir: &Path, patches: &[f64], recs: &[&Record]) -> Result<Vec<PathBuf>> {
     let series: Vec<Series> = patches
         .iter()
         .map(|&p| Series {
@@ -280,15 +297,19 @@ fn meso_charts(
             highlight: Vec::new(),
         })
         .collect();
-    files.extend(scatter(
+    scatter(
         &dir.join("dvr_vs_freq"),
         "Unstable modes of the plateau layouts",
         "frequency (Hz)",
         "DvR = Re(lambda)/Im(lambda)",
         series,
-    )?);
-    // Figures 23-26: layouts that trigger (largest DvR) or suppress each coupling (stable
-    // in that class although they hold the most pairs)
+    )
+}
+
+/// Figures 23-26: per class, the layouts that trigger the coupling (largest DvR) and those
+/// that suppress it (stable in that class although they hold the most pairs).
+fn trigger_and_suppress(dir: &Path, def: &StudyDef, recs: &[&Record]) -> Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
     let face = def.grid.face_m;
     let cells = def.grid.cells_m();
     for &c in &def.solve.classes_hz {
