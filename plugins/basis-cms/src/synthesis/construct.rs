@@ -79,43 +79,7 @@ impl FreeInterface {
         let n = k.nrows();
         let nr = pairs.len();
         let nm = modes.omega2.len();
-        if nr == 0 {
-            return Err(Error::Invalid(
-                "free-interface synthesis: no candidate contact pair".into(),
-            ));
-        }
-        if modes.vectors.nrows() != n || modes.vectors.ncols() != nm {
-            return Err(Error::Dimension {
-                context: "free-interface synthesis: mode shapes against K".into(),
-                expected: n,
-                got: modes.vectors.nrows(),
-            });
-        }
-        if m.nrows() != n || m.ncols() != n {
-            return Err(Error::Dimension {
-                context: "free-interface synthesis: M against K".into(),
-                expected: n,
-                got: m.nrows(),
-            });
-        }
-        if nm == 0 {
-            return Err(Error::Invalid(
-                "free-interface synthesis: no free-interface mode below the cutoff".into(),
-            ));
-        }
-        if let Some(&w) = modes.omega2.iter().find(|w| !(w.is_finite() && **w > 0.0)) {
-            return Err(Error::Invalid(format!(
-                "free-interface synthesis: eigenvalue omega^2 = {w:e} (rad/s)^2 is not \
-                 positive: the unconstrained model must be held (no rigid-body mode)"
-            )));
-        }
-        for (i, p) in pairs.iter().enumerate() {
-            if p.pin.iter().chain(&p.disc).any(|&d| d >= n) {
-                return Err(Error::Invalid(format!(
-                    "free-interface synthesis: pair {i} has a DOF beyond the model's {n}"
-                )));
-            }
-        }
+        check_inputs(k, m, pairs, modes)?;
         let factor = match factor {
             Some(f) if f.dim() == n => f,
             Some(f) => {
@@ -291,4 +255,55 @@ impl FreeInterface {
         }
         Ok(active)
     }
+}
+
+/// The inputs of [`FreeInterface::build`]: pairs present and inside the model, modes and
+/// `M` of the size of `K`, every kept eigenvalue positive (a held model).
+fn check_inputs(
+    k: SparseRef<'_>,
+    m: SparseRef<'_>,
+    pairs: &[PairDofs],
+    modes: &RealModes,
+) -> Result<()> {
+    let n = k.nrows();
+    let nr = pairs.len();
+    let nm = modes.omega2.len();
+    if nr == 0 {
+        return Err(Error::Invalid(
+            "free-interface synthesis: no candidate contact pair".into(),
+        ));
+    }
+    if modes.vectors.nrows() != n || modes.vectors.ncols() != nm {
+        return Err(Error::Dimension {
+            context: "free-interface synthesis: mode shapes against K".into(),
+            expected: n,
+            got: modes.vectors.nrows(),
+        });
+    }
+    if m.nrows() != n || m.ncols() != n {
+        return Err(Error::Dimension {
+            context: "free-interface synthesis: M against K".into(),
+            expected: n,
+            got: m.nrows(),
+        });
+    }
+    if nm == 0 {
+        return Err(Error::Invalid(
+            "free-interface synthesis: no free-interface mode below the cutoff".into(),
+        ));
+    }
+    if let Some(&w) = modes.omega2.iter().find(|w| !(w.is_finite() && **w > 0.0)) {
+        return Err(Error::Invalid(format!(
+            "free-interface synthesis: eigenvalue omega^2 = {w:e} (rad/s)^2 is not \
+             positive: the unconstrained model must be held (no rigid-body mode)"
+        )));
+    }
+    for (i, p) in pairs.iter().enumerate() {
+        if p.pin.iter().chain(&p.disc).any(|&d| d >= n) {
+            return Err(Error::Invalid(format!(
+                "free-interface synthesis: pair {i} has a DOF beyond the model's {n}"
+            )));
+        }
+    }
+    Ok(())
 }
