@@ -155,7 +155,7 @@ fn an_interrupted_study_resumes_to_the_same_bytes() {
     )
     .unwrap_err()
     .to_string();
-    assert!(e.starts_with("--out:") && e.contains("--resume"), "{e}");
+    assert!(e.starts_with("dir:") && e.contains("options.resume"), "{e}");
     let r = run(
         &f,
         &def,
@@ -273,7 +273,7 @@ fn bad_inputs_are_errors_naming_the_option() {
     }
     let e = msg(&d);
     assert!(
-        e.starts_with("--patch:") && e.contains("grid spacing") && e.contains(">= 10.000 mm"),
+        e.starts_with("study.patch_m:") && e.contains("grid spacing") && e.contains(">= 10.000 mm"),
         "{e}"
     );
     // patch not fitting in the region
@@ -282,29 +282,38 @@ fn bad_inputs_are_errors_naming_the_option() {
         s.region_m = [0.0, 0.0, 0.02, 0.008];
     }
     let e = msg(&d);
-    assert!(e.starts_with("--patch:") && e.contains("<= 0.008 m"), "{e}");
+    assert!(
+        e.starts_with("study.patch_m:") && e.contains("<= 0.008 m"),
+        "{e}"
+    );
     // region outside the face
     if let StudySpec::Meso(s) = &mut d.study {
         s.region_m = [0.005, 0.0, 0.02, 0.02];
     }
-    assert!(msg(&d).starts_with("--region:"), "{}", msg(&d));
+    assert!(msg(&d).starts_with("study.region_m:"), "{}", msg(&d));
     // zones outside the pin face
     let mut d = macro_def(&f);
     if let StudySpec::Macro(s) = &mut d.study {
         s.a_m = vec![0.03];
     }
     let e = msg(&d);
-    assert!(e.starts_with("--a:") && e.contains("(0, 0.02]"), "{e}");
+    assert!(
+        e.starts_with("study.a_m:") && e.contains("(0, 0.02]"),
+        "{e}"
+    );
     if let StudySpec::Macro(s) = &mut d.study {
         s.a_m = vec![0.01];
         s.x0 = Axis::Values(vec![0.0, 0.015]);
     }
     let e = msg(&d);
-    assert!(e.starts_with("--x0:") && e.contains("[0, 0.01]"), "{e}");
+    assert!(e.starts_with("study.x0:") && e.contains("[0, 0.01]"), "{e}");
     // bad shard specs
     for bad in ["0/2", "3/2", "2", "1/0", "x/y"] {
         let e = Shard::parse(bad).unwrap_err().to_string();
-        assert!(e.starts_with("--shard:") && e.contains("K/N"), "{bad}: {e}");
+        assert!(
+            e.starts_with("options.shard:") && e.contains("K/N"),
+            "{bad}: {e}"
+        );
     }
     // a directory of another study is refused on resume and in a merge
     let a = tmp("bad-a");
@@ -348,7 +357,7 @@ fn bad_inputs_are_errors_naming_the_option() {
         .to_string();
     assert!(e.contains("not a study directory"), "{e}");
     let e = merge(std::slice::from_ref(&a), &a).unwrap_err().to_string();
-    assert!(e.starts_with("--out:"), "{e}");
+    assert!(e.starts_with("dir:"), "{e}");
     for d in [a, b, out] {
         let _ = std::fs::remove_dir_all(d);
     }

@@ -23,11 +23,14 @@ fn um(v: f64) -> i64 {
 
 fn check_mu(mu: &[f64]) -> Result<()> {
     if mu.is_empty() {
-        return Err(input("--mu", "expected at least one friction coefficient"));
+        return Err(input(
+            "study.mu",
+            "expected at least one friction coefficient",
+        ));
     }
     if let Some(m) = mu.iter().find(|m| !(m.is_finite() && **m >= 0.0)) {
         return Err(input(
-            "--mu",
+            "study.mu",
             format!("expected friction coefficients >= 0, got {m} (reverse the scene's study.rotation instead of a negative mu)"),
         ));
     }
@@ -114,7 +117,7 @@ impl StudyDef {
     }
 
     /// The case list (sorted by id), with the skipped zones counted. Errors name the
-    /// option when no case is left or an input is out of range.
+    /// field when no case is left or an input is out of range.
     pub fn cases(&self) -> Result<CaseList> {
         let mut list = match &self.study {
             StudySpec::Macro(s) => self.macro_cases(s)?,
@@ -124,8 +127,8 @@ impl StudyDef {
         cases.sort_by(|a, b| a.id.cmp(&b.id));
         if let Some(w) = cases.windows(2).find(|w| w[0].id == w[1].id) {
             let option = match self.study {
-                StudySpec::Macro(_) => "--mu/--x0/--y0/--a/--b",
-                StudySpec::Meso(_) => "--mu/--patch",
+                StudySpec::Macro(_) => "study.mu/study.x0/study.y0/study.a_m/study.b_m",
+                StudySpec::Meso(_) => "study.mu/study.patch_m",
             };
             return Err(input(
                 option,
@@ -145,10 +148,10 @@ impl StudyDef {
         let mut cases = Vec::new();
         let mut skipped = Skipped::default();
         check_mu(&s.mu)?;
-        positive("--a", &s.a_m, "zone length")?;
-        positive("--b", &s.b_m, "zone width")?;
-        check_axis("--x0", "--a", &s.x0, &s.a_m, face[0], tol)?;
-        check_axis("--y0", "--b", &s.y0, &s.b_m, face[1], tol)?;
+        positive("study.a_m", &s.a_m, "zone length")?;
+        positive("study.b_m", &s.b_m, "zone width")?;
+        check_axis("study.x0", "study.a_m", &s.x0, &s.a_m, face[0], tol)?;
+        check_axis("study.y0", "study.b_m", &s.y0, &s.b_m, face[1], tol)?;
         for &mu in &s.mu {
             for &a in &s.a_m {
                 for &b in &s.b_m {
@@ -197,7 +200,7 @@ impl StudyDef {
         }
         if cases.is_empty() {
             return Err(input(
-                "--x0/--y0/--a/--b",
+                "study.x0/study.y0/study.a_m/study.b_m",
                 format!(
                     "no zone fits in the pin face ({} x {} mm) with a contact pair \
                      ({} outside the face, {} without a pair): zones are [x0, x0 + a] x \
@@ -235,19 +238,19 @@ impl StudyDef {
             && y0 + b <= face[1] + tol)
         {
             return Err(input(
-                "--region",
+                "study.region_m",
                 format!(
                     "[{x0}, {y0}, {a}, {b}] must lie inside the pin face ({} x {} m) with a, b > 0",
                     face[0], face[1]
                 ),
             ));
         }
-        positive("--patch", &s.patch_m, "patch side")?;
+        positive("study.patch_m", &s.patch_m, "patch side")?;
         if let Some(p) = s.patch_m.iter().find(|p| **p > a.min(b) * (1.0 + 1e-9)) {
             return Err(input(
-                "--patch",
+                "study.patch_m",
                 format!(
-                    "patch side {p} m does not fit in the region ({a} x {b} m, --region): \
+                    "patch side {p} m does not fit in the region ({a} x {b} m, study.region_m): \
                      expected patch sides <= {} m",
                     a.min(b)
                 ),
@@ -257,7 +260,7 @@ impl StudyDef {
         let sp = sp_in[0].max(sp_in[1]);
         if let Some(p) = s.patch_m.iter().find(|p| **p < sp * (1.0 - 1e-9)) {
             return Err(input(
-                "--patch",
+                "study.patch_m",
                 format!(
                     "patch side {:.3} mm is smaller than the contact grid spacing \
                      {:.3} mm of the scene in the region ({} x {} pairs on the face): \
@@ -280,13 +283,13 @@ impl StudyDef {
         }
         if s.layouts == 0 {
             return Err(input(
-                "--layouts",
+                "study.layouts",
                 "expected at least one layout per patch size",
             ));
         }
         if !(s.fraction > 0.0 && s.fraction <= 1.0) {
             return Err(input(
-                "--fraction",
+                "study.fraction",
                 format!(
                     "expected a fraction of the patches in (0, 1], got {}",
                     s.fraction
@@ -339,7 +342,7 @@ impl StudyDef {
         }
         if cases.is_empty() {
             return Err(input(
-                "--patch",
+                "study.patch_m",
                 format!(
                     "no layout holds a contact pair: the patches are smaller than the \
                      contact grid spacing ({:.3} x {:.3} mm); raise mesh.pin_face_elements \

@@ -108,7 +108,7 @@ impl Shard {
     pub fn parse(text: &str) -> Result<Self> {
         let bad = || {
             input(
-                "--shard",
+                "options.shard",
                 format!(
                     "`{text}`: expected K/N with 1 <= K <= N (e.g. 2/8: the second of 8 parts)"
                 ),

@@ -47,14 +47,16 @@ pub use summary::{
     summarize, wilson95, ClassSummary, GridSummary, MuSummary, PatchSummary, Summary, TimingSummary,
 };
 
-/// Errors of studies; each names the option, file or case concerned.
+/// Errors of studies; each names the field, file or case concerned.
 #[derive(Debug, Error)]
 pub enum StudyError {
-    /// A bad input, named by its command-line option.
-    #[error("{option}: {message}")]
+    /// A bad input, named by its field: `study.*` and `solve.*` of [`StudyDef`],
+    /// `options.*` of [`RunOptions`], `dir`, `dirs` or `scene` (the `squeal` binary names
+    /// the matching command-line options instead).
+    #[error("{field}: {message}")]
     Input {
-        /// The option, e.g. `--shard`.
-        option: String,
+        /// The field, e.g. `study.patch_m`.
+        field: String,
         /// What is wrong and what is expected.
         message: String,
     },
@@ -74,9 +76,9 @@ pub enum StudyError {
 /// Result with [`StudyError`].
 pub type Result<T> = std::result::Result<T, StudyError>;
 
-pub(crate) fn input(option: &str, message: impl Into<String>) -> StudyError {
+pub(crate) fn input(field: &str, message: impl Into<String>) -> StudyError {
     StudyError::Input {
-        option: option.into(),
+        field: field.into(),
         message: message.into(),
     }
 }

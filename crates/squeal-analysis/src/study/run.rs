@@ -237,9 +237,9 @@ fn claim(dir: &StudyDir, def: &StudyDef, resume: bool) -> Result<()> {
     let has_results = std::fs::metadata(dir.results()).is_ok_and(|m| m.len() > 0);
     if has_results && !resume {
         return Err(input(
-            "--out",
+            "dir",
             format!(
-                "{} already holds results: pass --resume to continue that study, or choose another directory",
+                "{} already holds results: set options.resume to continue that study, or choose another directory",
                 dir.dir.display()
             ),
         ));
@@ -257,7 +257,7 @@ fn claim(dir: &StudyDir, def: &StudyDef, resume: bool) -> Result<()> {
             return Err(files(
                 &dir.study(),
                 format!(
-                    "written for another study (differs at {}): use another --out",
+                    "written for another study (differs at {}): use another directory",
                     crate::jsonl::first_difference(&have, &want)
                 ),
             ));
@@ -318,7 +318,7 @@ pub fn run(
     def.solve.check()?;
     if model.dofs.n_free() != def.dofs {
         return Err(input(
-            "SCENE",
+            "scene",
             format!(
                 "the model has {} DOFs, the study {}",
                 model.dofs.n_free(),
@@ -418,7 +418,12 @@ pub fn run(
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(workers)
             .build()
-            .map_err(|e| input("--jobs", format!("cannot start {workers} workers: {e}")))?;
+            .map_err(|e| {
+                input(
+                    "options.jobs",
+                    format!("cannot start {workers} workers: {e}"),
+                )
+            })?;
         pool.scope(|s| {
             for _ in 0..workers {
                 s.spawn(|_| worker());
@@ -465,7 +470,7 @@ pub fn run(
 /// whole study. Errors if the shards are of different studies or disagree on a case.
 pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<(StudyDef, Summary, TimingSummary)> {
     let Some(first) = inputs.first() else {
-        return Err(input("DIRS", "expected at least one study directory"));
+        return Err(input("dirs", "expected at least one study directory"));
     };
     let def = StudyDir::new(first).read_def()?;
     let want = serde_json::to_value(&def).map_err(|e| files(first, e))?;
@@ -510,7 +515,7 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> Result<(StudyDef, Summary, Timin
             .any(|i| i.canonicalize().ok().as_ref() == Some(&o))
     }) {
         return Err(input(
-            "--out",
+            "dir",
             "the merged directory must not be one of the inputs",
         ));
     }

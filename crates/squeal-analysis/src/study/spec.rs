@@ -76,24 +76,24 @@ pub struct SolveSpec {
 }
 
 impl SolveSpec {
-    /// Checks the band, tolerances and classes, naming the options.
+    /// Checks the band, tolerances and classes, naming the fields.
     pub fn check(&self) -> Result<()> {
         let [lo, hi] = self.band_hz;
         if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && hi > lo) {
             return Err(input(
-                "--band",
+                "solve.band_hz",
                 format!("expected 0 <= FMIN < FMAX (Hz), got {lo}:{hi}"),
             ));
         }
         if !(self.tol > 0.0 && self.tol < 1.0) {
             return Err(input(
-                "--tol",
+                "solve.tol",
                 format!("expected a tolerance in (0, 1), got {}", self.tol),
             ));
         }
         if !(self.dvr_tol.is_finite() && self.dvr_tol >= 0.0) {
             return Err(input(
-                "--dvr-tol",
+                "solve.dvr_tol",
                 format!("expected a DvR threshold >= 0, got {}", self.dvr_tol),
             ));
         }
@@ -101,13 +101,13 @@ impl SolveSpec {
             || self.classes_hz.iter().any(|c| !(c.is_finite() && *c > 0.0))
         {
             return Err(input(
-                "--classes",
+                "solve.classes_hz",
                 format!("expected frequencies > 0 Hz, got {:?}", self.classes_hz),
             ));
         }
         if !(self.class_width > 0.0 && self.class_width < 1.0) {
             return Err(input(
-                "--class-width",
+                "solve.class_width",
                 format!(
                     "expected a relative half-width in (0, 1), got {}",
                     self.class_width
@@ -139,8 +139,8 @@ impl SolveSpec {
     pub fn method(&self, registry: &Registry) -> Result<Method> {
         let mut params = Params::new();
         for kv in &self.basis_params {
-            let (k, v) =
-                Params::parse_kv(kv).map_err(|e| input("--basis-opt", format!("`{kv}`: {e}")))?;
+            let (k, v) = Params::parse_kv(kv)
+                .map_err(|e| input("solve.basis_params", format!("`{kv}`: {e}")))?;
             params.0.insert(k, v);
         }
         Ok(Method::new(
@@ -172,7 +172,7 @@ impl GridInfo {
     pub fn of(model: &Model) -> Result<Self> {
         let grid = model.contact.as_ref().ok_or_else(|| {
             input(
-                "SCENE",
+                "scene",
                 "the model has no contact pairs: a study needs a scene with a [disc] and a [pin]",
             )
         })?;

@@ -137,7 +137,7 @@ fn shards_split_every_case_exactly_once() {
     for bad in ["0/2", "3/2", "1/0", "2", "a/b", "1/2/3", "-1/2", ""] {
         let e = message(Shard::parse(bad).unwrap_err());
         assert!(
-            e.starts_with("--shard: ") && e.contains("K/N"),
+            e.starts_with("options.shard: ") && e.contains("K/N"),
             "{bad:?}: {e}"
         );
     }
@@ -230,11 +230,20 @@ fn macro_grids_skip_combinations_that_leave_the_face() {
 fn zones_outside_the_face_are_errors_naming_the_option() {
     let cases = |x0: Axis, a: Vec<f64>| def(macro_spec(x0, Axis::Centred, a, vec![0.01])).cases();
     let e = message(cases(Axis::Centred, vec![0.025]).unwrap_err());
-    assert!(e.starts_with("--a: ") && e.contains("(0, 0.02]"), "{e}");
+    assert!(
+        e.starts_with("study.a_m: ") && e.contains("(0, 0.02]"),
+        "{e}"
+    );
     let e = message(cases(Axis::Values(vec![0.0, 0.019]), vec![0.004]).unwrap_err());
-    assert!(e.starts_with("--x0: ") && e.contains("[0, 0.016]"), "{e}");
+    assert!(
+        e.starts_with("study.x0: ") && e.contains("[0, 0.016]"),
+        "{e}"
+    );
     let e = message(cases(Axis::Values(vec![0.005]), vec![0.004, 0.018]).unwrap_err());
-    assert!(e.starts_with("--a: ") && e.contains("<= 0.015"), "{e}");
+    assert!(
+        e.starts_with("study.a_m: ") && e.contains("<= 0.015"),
+        "{e}"
+    );
     let e = message(
         def(macro_spec(
             Axis::Centred,
@@ -245,9 +254,9 @@ fn zones_outside_the_face_are_errors_naming_the_option() {
         .cases()
         .unwrap_err(),
     );
-    assert!(e.starts_with("--y0: "), "{e}");
+    assert!(e.starts_with("study.y0: "), "{e}");
     let e = message(cases(Axis::Centred, vec![0.0]).unwrap_err());
-    assert!(e.starts_with("--a: ") && e.contains("> 0"), "{e}");
+    assert!(e.starts_with("study.a_m: ") && e.contains("> 0"), "{e}");
     let mut d = def(macro_spec(
         Axis::Centred,
         Axis::Centred,
@@ -257,7 +266,7 @@ fn zones_outside_the_face_are_errors_naming_the_option() {
     if let StudySpec::Macro(s) = &mut d.study {
         s.mu = vec![-0.1];
     }
-    assert!(message(d.cases().unwrap_err()).starts_with("--mu: "));
+    assert!(message(d.cases().unwrap_err()).starts_with("study.mu: "));
     if let StudySpec::Macro(s) = &mut d.study {
         s.mu = vec![0.36, 0.36];
     }
@@ -296,31 +305,31 @@ fn meso_cases_are_seeded_layouts_inside_the_region() {
 fn bad_meso_inputs_name_the_option_and_the_expected_value() {
     let e = message(def(meso_spec(vec![0.0004])).cases().unwrap_err());
     assert!(
-        e.starts_with("--patch: ")
+        e.starts_with("study.patch_m: ")
             && e.contains("contact grid spacing")
             && e.contains(">= 1.000 mm"),
         "{e}"
     );
     let e = message(def(meso_spec(vec![0.009])).cases().unwrap_err());
     assert!(
-        e.starts_with("--patch: ") && e.contains("<= 0.008 m"),
+        e.starts_with("study.patch_m: ") && e.contains("<= 0.008 m"),
         "{e}"
     );
     let mut d = def(meso_spec(vec![0.001]));
     if let StudySpec::Meso(s) = &mut d.study {
         s.region_m = [0.015, 0.0, 0.008, 0.01];
     }
-    assert!(message(d.cases().unwrap_err()).starts_with("--region: "));
+    assert!(message(d.cases().unwrap_err()).starts_with("study.region_m: "));
     if let StudySpec::Meso(s) = &mut d.study {
         s.region_m = [0.0, 0.0, 0.008, 0.01];
         s.fraction = 0.0;
     }
-    assert!(message(d.cases().unwrap_err()).starts_with("--fraction: "));
+    assert!(message(d.cases().unwrap_err()).starts_with("study.fraction: "));
     if let StudySpec::Meso(s) = &mut d.study {
         s.fraction = 0.5;
         s.layouts = 0;
     }
-    assert!(message(d.cases().unwrap_err()).starts_with("--layouts: "));
+    assert!(message(d.cases().unwrap_err()).starts_with("study.layouts: "));
 }
 
 #[test]
@@ -333,10 +342,10 @@ fn classes_have_a_window() {
     s.check().unwrap();
     let mut bad = solve();
     bad.band_hz = [5000.0, 100.0];
-    assert!(message(bad.check().unwrap_err()).starts_with("--band: "));
+    assert!(message(bad.check().unwrap_err()).starts_with("solve.band_hz: "));
     let mut bad = solve();
     bad.class_width = 1.5;
-    assert!(message(bad.check().unwrap_err()).starts_with("--class-width: "));
+    assert!(message(bad.check().unwrap_err()).starts_with("solve.class_width: "));
 }
 
 #[test]
@@ -524,7 +533,9 @@ fn meso_patches_follow_the_grid_spacing_inside_their_region() {
     }
     let e = message(d.cases().unwrap_err());
     assert!(
-        e.starts_with("--patch: ") && e.contains(">= 1.000 mm") && e.contains("contact_refinement"),
+        e.starts_with("study.patch_m: ")
+            && e.contains(">= 1.000 mm")
+            && e.contains("contact_refinement"),
         "{e}"
     );
 }
