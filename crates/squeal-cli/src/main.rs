@@ -12,6 +12,7 @@ mod scene_cmd;
 mod stability;
 mod study;
 mod study_charts;
+mod study_flags;
 mod sweep;
 mod validate;
 

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use squeal_analysis::study::{
     self, parse_list, parse_region, Axis, MacroSpec, MesoSpec, Progress, RunOptions, Shard,
-    SolveSpec, StudyDef, StudyDir, StudyError, StudySpec, Summary,
+    SolveSpec, StudyDef, StudyDir, StudySpec, Summary,
 };
 use squeal_core::Registry;
 use std::io::IsTerminal;
@@ -204,7 +204,7 @@ fn solve_spec(o: &StudyOpts, scene: &squeal_scene::Scene) -> Result<SolveSpec> {
         classes_hz: parse_list("--classes", &o.classes)?,
         class_width: o.class_width,
     };
-    s.check().map_err(flags)?;
+    s.check().map_err(crate::study_flags::flags)?;
     Ok(s)
 }
 
@@ -216,7 +216,7 @@ fn run_options(o: &StudyOpts) -> Result<RunOptions> {
             .as_deref()
             .map(Shard::parse)
             .transpose()
-            .map_err(flags)?,
+            .map_err(crate::study_flags::flags)?,
         resume: o.resume,
         max_cases: o.max_cases,
     })
@@ -244,8 +244,9 @@ fn execute(
     crate::opts::set_resume_hint(out);
     eprintln!("building {file} ...");
     let model = squeal_scene::build(&scene, squeal_scene::BodyKind::All, registry, &file)?;
-    let def = StudyDef::new(&file, &scene, &model, spec, solve).map_err(flags)?;
-    let list = def.cases().map_err(flags)?;
+    let def =
+        StudyDef::new(&file, &scene, &model, spec, solve).map_err(crate::study_flags::flags)?;
+    let list = def.cases().map_err(crate::study_flags::flags)?;
     for w in def.warnings(&list) {
         eprintln!("warning: {w}");
     }
@@ -261,8 +262,8 @@ fn execute(
     );
     let bar = Bar::new();
     let dir = StudyDir::new(out);
-    let report =
-        study::run(registry, &model, &def, &dir, &opts, &|p| bar.update(p)).map_err(flags)?;
+    let report = study::run(registry, &model, &def, &dir, &opts, &|p| bar.update(p))
+        .map_err(crate::study_flags::flags)?;
     bar.finish();
     println!(
         "{} of {} cases in this run's part: {} computed now, {} found done, {} left{}",
@@ -300,55 +301,9 @@ fn execute(
     finish_outputs(&dir, &def, o.no_charts)
 }
 
-/// The command-line option of each field a study error names (`StudyError::Input`).
-const FLAGS: [(&str, &str); 21] = [
-    ("study.mu", "--mu"),
-    ("study.x0", "--x0"),
-    ("study.y0", "--y0"),
-    ("study.a_m", "--a"),
-    ("study.b_m", "--b"),
-    ("study.region_m", "--region"),
-    ("study.patch_m", "--patch"),
-    ("study.layouts", "--layouts"),
-    ("study.fraction", "--fraction"),
-    ("solve.band_hz", "--band"),
-    ("solve.dvr_tol", "--dvr-tol"),
-    ("solve.tol", "--tol"),
-    ("solve.classes_hz", "--classes"),
-    ("solve.class_width", "--class-width"),
-    ("solve.basis_params", "--basis-opt"),
-    ("options.shard", "--shard"),
-    ("options.jobs", "--jobs"),
-    ("options.resume", "--resume"),
-    ("dirs", "DIRS"),
-    ("dir", "--out"),
-    ("scene", "SCENE"),
-];
-
-/// A study error with its fields named as the command-line options that set them.
-fn flags(e: StudyError) -> anyhow::Error {
-    match e {
-        StudyError::Input { field, message } => {
-            let flag = |name: &str| {
-                FLAGS
-                    .iter()
-                    .find(|(f, _)| *f == name)
-                    .map_or(name.to_string(), |(_, o)| (*o).to_string())
-            };
-            let field = field.split('/').map(flag).collect::<Vec<_>>().join("/");
-            let message = FLAGS
-                .iter()
-                .filter(|(f, _)| f.contains('.'))
-                .fold(message, |m, (f, o)| m.replace(f, o));
-            anyhow::anyhow!("{field}: {message}")
-        }
-        e => e.into(),
-    }
-}
-
 /// `squeal merge DIR... --out DIR`.
 pub fn merge(dirs: &[PathBuf], out: &Path, no_charts: bool) -> Result<()> {
-    let (def, summary, _) = study::merge(dirs, out).map_err(flags)?;
+    let (def, summary, _) = study::merge(dirs, out).map_err(crate::study_flags::flags)?;
     println!(
         "merged {} directories: {} of {} cases{}",
         dirs.len(),
@@ -552,50 +507,4 @@ pub fn check_dirs(dirs: &[PathBuf]) -> Result<()> {
         }
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{flags, StudyError};
-
-    fn input(field: &str, message: &str) -> String {
-        flags(StudyError::Input {
-            field: field.into(),
-            message: message.into(),
-        })
-        .to_string()
-    }
-
-    #[test]
-    fn study_fields_are_named_as_their_options() {
-        assert_eq!(
-            input(
-                "study.x0",
-                "a zone starting at 0.015 m leaves the face even with the smallest study.a_m \
-                 0.01 m: expected study.x0 in [0, 0.01] m"
-            ),
-            "--x0: a zone starting at 0.015 m leaves the face even with the smallest --a \
-             0.01 m: expected --x0 in [0, 0.01] m"
-        );
-        assert_eq!(
-            input("study.mu/study.patch_m", "two cases have the same id"),
-            "--mu/--patch: two cases have the same id"
-        );
-        assert_eq!(
-            input(
-                "dir",
-                "x already holds results: set options.resume to continue"
-            ),
-            "--out: x already holds results: set --resume to continue"
-        );
-        assert_eq!(
-            input("solve.dvr_tol", "expected solve.tol and solve.dvr_tol > 0"),
-            "--dvr-tol: expected --tol and --dvr-tol > 0"
-        );
-        // a field of the scene file is not an option
-        assert_eq!(
-            input("study.mu", "reverse the scene's study.rotation"),
-            "--mu: reverse the scene's study.rotation"
-        );
-    }
 }
