@@ -311,22 +311,44 @@ impl Runner<'_> {
         run
     }
 
+    /// Builds basis `basis` with parameters `p` on the case's operator (its model stage
+    /// from the runner's stages, if it has one) and projects the operator on it.
+    fn reduced_operator(&self, basis: &str, p: &Params) -> Result<ReducedOperator> {
+        let (op, mu, opts) = (self.op, self.mu, self.opts);
+        let plugin = self
+            .registry
+            .bases
+            .create(basis, p)
+            .map_err(core(format!("basis `{basis}`")))?;
+        let modal = eigen_solver(self.registry, &opts.modal)?;
+        let dense = eigen_solver(self.registry, "dense")?;
+        let stage = plugin.stage_key(opts.band_hz[1]).and_then(|key| {
+            self.stages
+                .iter()
+                .find(|s| s.key == key)
+                .map(|s| s.stage.as_ref())
+        });
+        let req = BasisRequest {
+            op,
+            mu,
+            band_hz: (opts.band_hz[0], opts.band_hz[1]),
+            modal: modal.as_ref(),
+            reduced: dense.as_ref(),
+            params: &self.params,
+            stage,
+        };
+        let b = squeal_core::contact::build_basis(plugin.as_ref(), &req)
+            .map_err(core(format!("basis `{basis}` at mu = {mu}")))?;
+        ReducedOperator::new(op, b).map_err(core(format!("projection on `{basis}`")))
+    }
+
     /// Basis `basis` with parameters `p` (labelled `label`) built once, then every eigen
     /// solver on it; each run goes to `push` as it finishes.
     fn reduced(&self, basis: &str, label: &str, p: &Params, push: &mut impl FnMut(BenchRun)) {
         let (op, mu, opts) = (self.op, self.mu, self.opts);
         let meter = Meter::start(self.memory);
         let t = Instant::now();
-        let built = reduced_operator(
-            self.registry,
-            basis,
-            p,
-            op,
-            mu,
-            opts,
-            self.stages,
-            &self.params,
-        );
+        let built = self.reduced_operator(basis, p);
         let setup_s = t.elapsed().as_secs_f64();
         let setup_peak = meter.peak_mb();
         let red = match built {
@@ -377,46 +399,6 @@ fn eigen_solver(registry: &Registry, name: &str) -> Result<Box<dyn EigenSolver>>
         .eigen
         .create(name, &Params::new())
         .map_err(core(format!("eigen solver `{name}`")))
-}
-
-/// Builds basis `basis` with parameters `p` on `op` at `mu` (its model stage from
-/// `stages`, if it has one) and projects `op` on it.
-#[allow(clippy::too_many_arguments)]
-fn reduced_operator(
-    registry: &Registry,
-    basis: &str,
-    p: &Params,
-    op: &FrictionalOperator,
-    mu: f64,
-    opts: &BenchOptions,
-    stages: &Stages,
-    params: &EigenParams,
-) -> Result<ReducedOperator> {
-    let create = |name: &str| eigen_solver(registry, name);
-    let plugin = registry
-        .bases
-        .create(basis, p)
-        .map_err(core(format!("basis `{basis}`")))?;
-    let modal = create(&opts.modal)?;
-    let dense = create("dense")?;
-    let stage = plugin.stage_key(opts.band_hz[1]).and_then(|key| {
-        stages
-            .iter()
-            .find(|s| s.key == key)
-            .map(|s| s.stage.as_ref())
-    });
-    let req = BasisRequest {
-        op,
-        mu,
-        band_hz: (opts.band_hz[0], opts.band_hz[1]),
-        modal: modal.as_ref(),
-        reduced: dense.as_ref(),
-        params,
-        stage,
-    };
-    let b = squeal_core::contact::build_basis(plugin.as_ref(), &req)
-        .map_err(core(format!("basis `{basis}` at mu = {mu}")))?;
-    ReducedOperator::new(op, b).map_err(core(format!("projection on `{basis}`")))
 }
 
 /// Adds condition numbers to full-order `modes` when `opts.condition` asks for them and
