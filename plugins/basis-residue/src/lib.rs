@@ -11,7 +11,9 @@
 //!    response `d_j = K_s^-1 r_j` with one factorization of `K_s = K_c + shift M_c`
 //!    reused for every iteration, energy-norm residual
 //!    `eps_j = sqrt(d_j^H K_s d_j) / sqrt(u_j^H K_s u_j)`
-//!    ([`squeal_core::reduction::energy_residuals`]);
+//!    ([`squeal_core::reduction::energy_residuals`], formed from the images `K_c V`,
+//!    `M_c V` kept by [`GrowingBasis`]: each column is multiplied by the large sparse
+//!    parts once, when it joins the basis);
 //! 3. stop when `max_j eps_j <= tol` (converged) or after `max_iterations` enrichments;
 //!    else add `Re d_j` and `Im d_j` of every unconverged target and re-orthonormalize
 //!    (`M_c`, rank cut of [`squeal_core::reduction`]).
@@ -34,8 +36,7 @@
 use squeal_core::faer::Mat;
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
-    coupled_real_modes, energy_residuals, expand, m_orthonormal_extend, m_orthonormalize, project,
-    StaticSolver, DEFAULT_RANK_TOL,
+    coupled_real_modes, m_orthonormalize, GrowingBasis, StaticSolver, DEFAULT_RANK_TOL,
 };
 use squeal_core::{
     Basis, BasisRequest, EigenParams, Error, Params, ReductionBasis, Registry, Result,
@@ -132,9 +133,9 @@ impl ReductionBasis for ResidueBasis {
         let (fmin, fmax) = request.band_hz;
         let cutoff = self.cutoff_factor * fmax;
         let modes = coupled_real_modes(request, cutoff)?;
-        let (mut v, mut dropped) = m_orthonormalize(mc, modes.vectors.as_ref(), self.rank_tol)?;
+        let (v, mut dropped) = m_orthonormalize(mc, modes.vectors.as_ref(), self.rank_tol)?;
         let start_size = v.ncols();
-        let qep = op.at(mu)?;
+        let mut v = GrowingBasis::new(op, v)?;
         let shift = (2.0 * std::f64::consts::PI * self.shift_hz).powi(2);
         let ks = StaticSolver::new(op, shift)?;
         let targets = EigenParams {
@@ -147,7 +148,7 @@ impl ReductionBasis for ResidueBasis {
         let mut history = Vec::new();
         let mut projected;
         let residual = loop {
-            let reduced = project(op, v.as_ref())?;
+            let reduced = v.project()?;
             let red = request.reduced.solve_frictional(&reduced, mu, &targets)?;
             projected = reduced;
             if red.is_empty() {
@@ -157,8 +158,7 @@ impl ReductionBasis for ResidueBasis {
                 ));
                 break 0.0;
             }
-            let u = expand(v.as_ref(), red.vectors.as_ref());
-            let (eps, d) = energy_residuals(&qep, &ks, &red.lambda, u.as_ref());
+            let (eps, d) = v.energy_residuals(mu, &ks, &red.lambda, red.vectors.as_ref());
             let residual = eps.iter().fold(0.0f64, |a, &b| a.max(b));
             history.push(residual);
             if residual <= self.tol {
@@ -173,7 +173,7 @@ impl ReductionBasis for ResidueBasis {
                 break residual;
             }
             let bad: Vec<usize> = (0..eps.len()).filter(|&j| eps[j] > self.tol).collect();
-            let n = v.nrows();
+            let n = op.dim();
             let new = Mat::from_fn(n, 2 * bad.len(), |r, c| {
                 let z = d[(r, bad[c / 2])];
                 if c % 2 == 0 {
@@ -182,12 +182,10 @@ impl ReductionBasis for ResidueBasis {
                     z.im
                 }
             });
-            let before = v.ncols();
-            let (next, dr) = m_orthonormal_extend(mc, v.as_ref(), new.as_ref(), self.rank_tol)?;
-            dropped += dr;
-            v = next;
+            let before = v.len();
+            dropped += v.extend(new.as_ref(), self.rank_tol)?;
             iterations += 1;
-            if v.ncols() == before {
+            if v.len() == before {
                 notes.push(format!(
                     "{NAME}: stagnated: every new residual direction fell under the rank cut \
                      (energy residual {residual:.3e})"
@@ -195,7 +193,7 @@ impl ReductionBasis for ResidueBasis {
                 break residual;
             }
         };
-        let mut basis = Basis::new(v);
+        let mut basis = Basis::new(v.into_columns());
         // every exit of the loop leaves `v` as it was last projected (the stagnation exit
         // kept its columns)
         basis.projected = Some(projected);

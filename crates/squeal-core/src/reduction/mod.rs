@@ -6,7 +6,8 @@
 //! - the coupled mu = 0 real modes ([`coupled_real_modes`]), the friction load directions
 //!   ([`friction_load_directions`]) and static responses with one reused factorization
 //!   ([`StaticSolver`]);
-//! - projection of every part of a [`FrictionalOperator`](crate::contact::FrictionalOperator) on a basis ([`project`]), the
+//! - projection of every part of a [`FrictionalOperator`](crate::contact::FrictionalOperator) on a basis ([`project`]), or of a
+//!   basis grown column by column with the images of its columns kept ([`GrowingBasis`]), the
 //!   reduced solve with any [`EigenSolver`](crate::EigenSolver), and the expansion of the reduced modes with
 //!   their backward errors on the FULL operator ([`ReducedOperator`], [`solve_reduced`]);
 //! - the MAC between a real and a complex mode ([`mac_real_complex`]).
@@ -41,6 +42,7 @@ use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef, Par};
 
 mod candidates;
+mod growing;
 mod mac;
 mod orthonormal;
 mod project;
@@ -50,10 +52,11 @@ mod statics;
 mod tests;
 
 pub use candidates::{coupled_real_modes, friction_load_directions};
+pub use growing::GrowingBasis;
 pub use mac::mac_real_complex;
 pub use orthonormal::{
-    m_orthonormal_extend, m_orthonormality_error, m_orthonormalize, m_svd_compress,
-    DEFAULT_RANK_TOL,
+    m_orthonormal_extend, m_orthonormal_extend_imaged, m_orthonormality_error, m_orthonormalize,
+    m_svd_compress, DEFAULT_RANK_TOL,
 };
 pub use project::{expand, project};
 pub use solve::{solve_reduced, ReducedOperator, ReducedSolve};

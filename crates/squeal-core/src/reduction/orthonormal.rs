@@ -61,6 +61,11 @@ pub fn m_orthonormal_extend(
     rank_tol: f64,
 ) -> Result<(Mat<f64>, usize)> {
     check_rank_tol(rank_tol)?;
+    check_dims(m, q, new)?;
+    m_orthonormal_extend_imaged(m, q, sparse_times(m, q).as_ref(), new, rank_tol)
+}
+
+fn check_dims(m: SparseRef<'_>, q: MatRef<'_, f64>, new: MatRef<'_, f64>) -> Result<()> {
     let n = m.nrows();
     if m.ncols() != n {
         return Err(Error::Dimension {
@@ -78,13 +83,38 @@ pub fn m_orthonormal_extend(
             });
         }
     }
+    Ok(())
+}
+
+/// [`m_orthonormal_extend`] when the caller holds the `M` image of the kept columns,
+/// `mq = M q` (an iterative basis that keeps the images of its columns): `mq` replaces
+/// the sparse product over every kept column; the result is the same.
+pub fn m_orthonormal_extend_imaged(
+    m: SparseRef<'_>,
+    q: MatRef<'_, f64>,
+    mq: MatRef<'_, f64>,
+    new: MatRef<'_, f64>,
+    rank_tol: f64,
+) -> Result<(Mat<f64>, usize)> {
+    check_rank_tol(rank_tol)?;
+    check_dims(m, q, new)?;
+    let n = m.nrows();
+    if mq.nrows() != n || mq.ncols() != q.ncols() {
+        return Err(Error::Dimension {
+            context: format!(
+                "M-orthonormalization: the M image of the kept columns is {} x {}",
+                mq.nrows(),
+                mq.ncols()
+            ),
+            expected: n * q.ncols(),
+            got: mq.nrows() * mq.ncols(),
+        });
+    }
     let cap = q.ncols() + new.ncols();
     let mut out = Mat::<f64>::zeros(n, cap);
     let mut mout = Mat::<f64>::zeros(n, cap);
     out.as_mut().subcols_mut(0, q.ncols()).copy_from(q);
-    mout.as_mut()
-        .subcols_mut(0, q.ncols())
-        .copy_from(sparse_times(m, q).as_ref());
+    mout.as_mut().subcols_mut(0, q.ncols()).copy_from(mq);
     let mut k = q.ncols();
     let mut dropped = 0;
     let mut w = vec![0.0; n];

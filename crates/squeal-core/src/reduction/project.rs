@@ -24,7 +24,7 @@ pub(super) fn dense_to_sparse(a: MatRef<'_, f64>) -> Result<SparseMat> {
 
 /// `V^T X V` exploiting the zero rows of `X` (the friction parts have `4 nA` nonzero
 /// rows).
-fn project_part(x: SparseRef<'_>, v: MatRef<'_, f64>) -> Result<SparseMat> {
+pub(super) fn project_part(x: SparseRef<'_>, v: MatRef<'_, f64>) -> Result<SparseMat> {
     let n = x.nrows();
     let mut used = vec![false; n];
     for j in 0..x.ncols() {
@@ -84,7 +84,25 @@ pub fn project(op: &FrictionalOperator, v: MatRef<'_, f64>) -> Result<Frictional
     let opt = |x: &Option<SparseMat>| -> Result<Option<SparseMat>> {
         x.as_ref().map(|x| project_part(x.as_ref(), v)).transpose()
     };
-    let friction_loads = match &op.friction_loads {
+    let friction_loads = project_loads(op, v)?;
+    Ok(FrictionalOperator {
+        mc: project_part(op.mc.as_ref(), v)?,
+        cc: opt(&op.cc)?,
+        kc: project_part(op.kc.as_ref(), v)?,
+        fm: project_part(op.fm.as_ref(), v)?,
+        fc: opt(&op.fc)?,
+        fk: project_part(op.fk.as_ref(), v)?,
+        t: None,
+        friction_loads,
+    })
+}
+
+/// `V^T U` of the friction load directions, when the operator carries them.
+pub(super) fn project_loads(
+    op: &FrictionalOperator,
+    v: MatRef<'_, f64>,
+) -> Result<Option<SparseMat>> {
+    Ok(match &op.friction_loads {
         Some(u) => {
             // V^T U column by column: U has a few nonzeros per column (never densified:
             // `n x nA` would be gigabytes for thousands of pairs)
@@ -100,16 +118,6 @@ pub fn project(op: &FrictionalOperator, v: MatRef<'_, f64>) -> Result<Frictional
             Some(dense_to_sparse(r.as_ref())?)
         }
         None => None,
-    };
-    Ok(FrictionalOperator {
-        mc: project_part(op.mc.as_ref(), v)?,
-        cc: opt(&op.cc)?,
-        kc: project_part(op.kc.as_ref(), v)?,
-        fm: project_part(op.fm.as_ref(), v)?,
-        fc: opt(&op.fc)?,
-        fk: project_part(op.fk.as_ref(), v)?,
-        t: None,
-        friction_loads,
     })
 }
 

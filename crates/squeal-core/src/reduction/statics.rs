@@ -82,8 +82,6 @@ pub fn energy_residuals(
             rr[(r, 2 * j + 1)] = v.im;
         }
     }
-    let mut d = rr.clone();
-    ks.solve_in_place(d.as_mut());
     let ur = Mat::from_fn(n, 2 * k, |r, c| {
         let z = u[(r, c / 2)];
         if c % 2 == 0 {
@@ -93,6 +91,21 @@ pub fn energy_residuals(
         }
     });
     let ksu = sparse_times(ks.matrix(), ur.as_ref());
+    energy_norms(ks, rr, ur.as_ref(), ksu.as_ref())
+}
+
+/// The energy-norm residuals from the residuals `rr` and the vectors `ur` with their
+/// images `ksu = K_s ur`, all `n x 2k` (real and imaginary parts of mode `j` in columns
+/// `2j` and `2j + 1`): `eps_j` and `d_j = K_s^-1 r_j` (see [`energy_residuals`]).
+pub(super) fn energy_norms(
+    ks: &StaticSolver,
+    rr: Mat<f64>,
+    ur: MatRef<'_, f64>,
+    ksu: MatRef<'_, f64>,
+) -> (Vec<f64>, Mat<c64>) {
+    let (n, k) = (rr.nrows(), rr.ncols() / 2);
+    let mut d = rr.clone();
+    ks.solve_in_place(d.as_mut());
     let mut eps = Vec::with_capacity(k);
     for j in 0..k {
         let num: f64 = (0..n)

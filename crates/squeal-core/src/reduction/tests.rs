@@ -376,3 +376,67 @@ fn mac_is_phase_independent() {
     let mac = mac_real_complex(op.mc.as_ref(), &phi, &orth);
     assert!(mac < 1e-24, "{mac}");
 }
+
+#[test]
+fn a_grown_basis_projects_and_measures_residuals_as_the_direct_path() {
+    let mut op = operator(30, 3, true, 21);
+    // a damped operator, so the kept C_c image is exercised too
+    let c = Mat::from_fn(30, 30, |i, j| if i == j { 2.0 } else { 0.0 });
+    op.cc = Some(sparse(c.as_ref()));
+    let mc = op.mc.as_ref();
+    let mut rng = Rng(5);
+    let (v0, _) = m_orthonormalize(mc, rng.mat(30, 6).as_ref(), DEFAULT_RANK_TOL).unwrap();
+    let more = rng.mat(30, 5);
+    let mut grown = GrowingBasis::new(&op, v0.clone()).unwrap();
+    let dropped = grown.extend(more.as_ref(), DEFAULT_RANK_TOL).unwrap();
+    assert_eq!((grown.len(), dropped), (11, 0));
+    // the same columns as the one-shot extension
+    let (direct, _) =
+        m_orthonormal_extend(mc, v0.as_ref(), more.as_ref(), DEFAULT_RANK_TOL).unwrap();
+    let diff = (&direct - grown.columns()).norm_max();
+    assert!(diff < 1e-12, "columns differ by {diff:e}");
+    // a dependent column is dropped and counted
+    let dep = grown.columns().subcols(0, 2).to_owned();
+    assert_eq!(grown.extend(dep.as_ref(), DEFAULT_RANK_TOL).unwrap(), 2);
+    assert_eq!(grown.len(), 11);
+    // the projection from the kept images is that of `project`, part by part
+    let a = grown.project().unwrap();
+    let b = project(&op, grown.columns()).unwrap();
+    for (x, y) in [
+        (&a.mc, &b.mc),
+        (&a.kc, &b.kc),
+        (&a.fk, &b.fk),
+        (&a.fm, &b.fm),
+    ] {
+        assert_eq!(x.to_dense(), y.to_dense());
+    }
+    let (ac, bc) = (a.cc.unwrap().to_dense(), b.cc.unwrap().to_dense());
+    assert!((&ac - &bc).norm_max() <= 1e-12 * bc.norm_max());
+    // residuals of reduced modes from the images = those of the sparse products
+    let mu = 0.3;
+    let red = dense_qep(&grown.project().unwrap().at(mu).unwrap()).unwrap();
+    let q = red.1.as_ref().subcols(0, 4);
+    let lambda = &red.0[..4];
+    let ks = StaticSolver::new(&op, 1e3).unwrap();
+    let (eps, d) = grown.energy_residuals(mu, &ks, lambda, q);
+    let u = expand(grown.columns(), q);
+    let (eps0, d0) = energy_residuals(&op.at(mu).unwrap(), &ks, lambda, u.as_ref());
+    for (e, e0) in eps.iter().zip(&eps0) {
+        assert!(
+            e0.is_finite() && *e0 > 0.0 && (e - e0).abs() <= 1e-8 * e0,
+            "{e} vs {e0}"
+        );
+    }
+    let dd = (0..d.nrows())
+        .flat_map(|r| (0..d.ncols()).map(move |c| (r, c)))
+        .map(|(r, c)| (d[(r, c)] - d0[(r, c)]).norm())
+        .fold(0.0f64, f64::max);
+    let scale = (0..d0.nrows())
+        .flat_map(|r| (0..d0.ncols()).map(move |c| (r, c)))
+        .map(|(r, c)| d0[(r, c)].norm())
+        .fold(0.0f64, f64::max);
+    assert!(
+        dd <= 1e-10 * scale,
+        "static responses differ by {dd:e} of {scale:e}"
+    );
+}
