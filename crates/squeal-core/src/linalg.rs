@@ -105,6 +105,74 @@ pub fn sparse_times(a: SparseRef<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
     y
 }
 
+/// `A^T X` for a sparse `A` (CSC) and a dense `X`: every entry is a gather over one
+/// column of `A` (its rows in ascending order), so no entry of the result is written more
+/// than once. With the columns of `X` in blocks of 16, 8 or 4 run in parallel as in
+/// [`sparse_times`], this is about twice as fast as that scatter product; it gives
+/// `V^T A V = (A^T V)^T V` for any `A`, and `A X` itself for a symmetric `A`.
+///
+/// # Panics
+/// If `A` has not as many rows as `X` (a programming error, as in faer).
+pub fn sparse_transpose_times(a: SparseRef<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
+    assert_eq!(
+        a.nrows(),
+        x.nrows(),
+        "sparse_transpose_times: A has {} rows but X {}",
+        a.nrows(),
+        x.nrows()
+    );
+    let mut y = Mat::<f64>::zeros(a.ncols(), x.ncols());
+    if a.ncols() > 0 && x.ncols() > 0 {
+        match x.ncols() {
+            c if c >= 12 => gather_blocks::<16>(a, x, y.as_mut()),
+            c if c >= 5 => gather_blocks::<8>(a, x, y.as_mut()),
+            _ => gather_blocks::<4>(a, x, y.as_mut()),
+        }
+    }
+    y
+}
+
+/// [`sparse_transpose_times`] by blocks of `W` columns of `X` (the last one padded).
+fn gather_blocks<const W: usize>(a: SparseRef<'_>, x: MatRef<'_, f64>, y: MatMut<'_, f64>) {
+    let block = |c0: usize, mut yb: MatMut<'_, f64>| {
+        let b = yb.ncols();
+        // the block of X row by row, W values per row
+        let mut xt = vec![[0.0f64; W]; a.nrows()];
+        for t in 0..b {
+            for (i, &v) in x.col(c0 + t).iter().enumerate() {
+                xt[i][t] = v;
+            }
+        }
+        for j in 0..a.ncols() {
+            let mut acc = [0.0f64; W];
+            for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+                let xi = &xt[i];
+                for t in 0..W {
+                    acc[t] += v * xi[t];
+                }
+            }
+            for (t, &v) in acc.iter().enumerate().take(b) {
+                yb[(j, t)] = v;
+            }
+        }
+    };
+    match faer::get_global_parallelism() {
+        Par::Seq => {
+            let mut y = y;
+            for c0 in (0..y.ncols()).step_by(W) {
+                let b = W.min(y.ncols() - c0);
+                block(c0, y.as_mut().subcols_mut(c0, b));
+            }
+        }
+        Par::Rayon(_) => {
+            use rayon::prelude::*;
+            y.par_col_chunks_mut(W)
+                .enumerate()
+                .for_each(|(k, yb)| block(k * W, yb))
+        }
+    }
+}
+
 /// [`sparse_times`] by blocks of `W` columns of `X` (the last one padded with zeros).
 fn sparse_times_blocks<const W: usize>(a: SparseRef<'_>, x: MatRef<'_, f64>, y: MatMut<'_, f64>) {
     let block = |c0: usize, mut yb: MatMut<'_, f64>| {
@@ -476,6 +544,44 @@ mod tests {
             sparse_times(a.as_ref(), Mat::<f64>::zeros(29, 0).as_ref()).ncols(),
             0
         );
+    }
+
+    #[test]
+    fn transpose_product_is_the_product_by_the_transpose() {
+        let mut state = 7u64;
+        let mut rnd = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        // a non-symmetric 37 x 29 pattern with empty rows and columns
+        let mut t = Vec::new();
+        for j in 0..29 {
+            for i in 0..37 {
+                if (i * 5 + j * 3) % 7 == 0 && i != 4 && j != 11 {
+                    t.push(Triplet::new(i, j, rnd()));
+                }
+            }
+        }
+        let a = SparseMat::try_new_from_triplets(37, 29, &t).unwrap();
+        let at = a.as_ref().transpose().to_col_major().unwrap();
+        for c in [1usize, 3, 5, 9, 12, 17, 40] {
+            let x = Mat::from_fn(37, c, |_, _| rnd());
+            let got = sparse_transpose_times(a.as_ref(), x.as_ref());
+            let want = sparse_times(at.as_ref(), x.as_ref());
+            assert_eq!((got.nrows(), got.ncols()), (29, c));
+            for j in 0..29 {
+                for k in 0..c {
+                    let (g, w) = (got[(j, k)], want[(j, k)]);
+                    assert!(
+                        (g - w).abs() <= 1e-14 * (1.0 + w.abs()),
+                        "{c}: ({j}, {k}) {g} {w}"
+                    );
+                }
+            }
+            assert!((0..c).all(|k| got[(11, k)] == 0.0), "an empty column of A");
+        }
     }
 
     #[test]

@@ -30,17 +30,106 @@ impl FillOrdering {
     /// The ordering of a symmetric pattern (either triangle or both; the diagonal is
     /// ignored): nested dissection at [`NESTED_DISSECTION_MIN_DIM`] unknowns and above,
     /// `None` below (the factorization then uses AMD).
+    ///
+    /// The orderings of the most recent patterns are kept ([`CACHE_BYTES`]): every
+    /// contact set of a model, once ordered, is ordered again for free when a later stage
+    /// factorizes a matrix of the same pattern (the shifted stiffness of the real modes,
+    /// the static responses, the full-order reference's pencil).
     pub fn of(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Option<Self>> {
         if pattern.nrows() < NESTED_DISSECTION_MIN_DIM {
             return Ok(None);
         }
-        nested_dissection(pattern).map(Some)
+        let key = PatternKey::of(pattern);
+        if let Some(hit) = cache::get(&key) {
+            return Ok(Some(hit));
+        }
+        let ordering = nested_dissection(pattern)?;
+        cache::put(key, &ordering);
+        Ok(Some(ordering))
     }
 
     /// As faer's [`SymmetricOrdering`].
     pub fn as_symmetric(&self) -> SymmetricOrdering<'_, usize> {
         let n = self.forward.len();
         SymmetricOrdering::Custom(PermRef::new_checked(&self.forward, &self.inverse, n))
+    }
+}
+
+/// Memory (bytes) the orderings of recent patterns may take ([`FillOrdering::of`]); at
+/// most [`CACHE_ENTRIES`] are kept, the least recently used going first.
+pub const CACHE_BYTES: usize = 128 << 20;
+
+/// Most orderings kept ([`CACHE_BYTES`]).
+pub const CACHE_ENTRIES: usize = 16;
+
+/// A pattern's identity: its size, its number of entries and two independent 64-bit
+/// hashes of its column pointers and row indices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct PatternKey {
+    n: usize,
+    nnz: usize,
+    hash: [u64; 2],
+}
+
+impl PatternKey {
+    fn of(pattern: SymbolicSparseColMatRef<'_, usize>) -> Self {
+        let mut hash = [0x9e37_79b9_7f4a_7c15u64, 0xc2b2_ae3d_27d4_eb4fu64];
+        let mut mix = |w: u64| {
+            hash[0] = (hash[0] ^ w)
+                .wrapping_mul(0x0000_0100_0000_01b3)
+                .rotate_left(29);
+            hash[1] = (hash[1].rotate_left(17) ^ w).wrapping_mul(0xff51_afd7_ed55_8ccd);
+        };
+        let n = pattern.ncols();
+        let mut nnz = 0;
+        for j in 0..n {
+            let rows = pattern.row_idx_of_col_raw(j);
+            mix(rows.len() as u64 ^ ((j as u64) << 32));
+            for &i in rows {
+                mix(i as u64);
+            }
+            nnz += rows.len();
+        }
+        Self {
+            n: pattern.nrows(),
+            nnz,
+            hash,
+        }
+    }
+}
+
+/// The orderings of recent patterns, most recent last.
+mod cache {
+    use super::{FillOrdering, PatternKey, CACHE_BYTES, CACHE_ENTRIES};
+    use std::sync::Mutex;
+
+    static RECENT: Mutex<Vec<(PatternKey, FillOrdering)>> = Mutex::new(Vec::new());
+
+    fn bytes(o: &FillOrdering) -> usize {
+        (o.forward.len() + o.inverse.len()) * std::mem::size_of::<usize>()
+    }
+
+    pub(super) fn get(key: &PatternKey) -> Option<FillOrdering> {
+        let mut recent = RECENT.lock().unwrap_or_else(|e| e.into_inner());
+        let at = recent.iter().position(|(k, _)| k == key)?;
+        let entry = recent.remove(at);
+        let hit = entry.1.clone();
+        recent.push(entry);
+        Some(hit)
+    }
+
+    pub(super) fn put(key: PatternKey, ordering: &FillOrdering) {
+        if bytes(ordering) > CACHE_BYTES {
+            return;
+        }
+        let mut recent = RECENT.lock().unwrap_or_else(|e| e.into_inner());
+        recent.retain(|(k, _)| *k != key);
+        recent.push((key, ordering.clone()));
+        while recent.len() > CACHE_ENTRIES
+            || recent.iter().map(|(_, o)| bytes(o)).sum::<usize>() > CACHE_BYTES
+        {
+            recent.remove(0);
+        }
     }
 }
 
@@ -201,9 +290,18 @@ mod tests {
             assert!(!seen[old] && nd.inverse[old] == new);
             seen[old] = true;
         }
-        // the same ordering again (METIS's fixed seed): results repeat from run to run
-        let again = FillOrdering::of(a.symbolic()).unwrap().unwrap();
+        // the same ordering again from METIS itself (its fixed seed): results repeat from
+        // run to run; and from the cache of recent patterns
+        let again = nested_dissection(a.symbolic()).unwrap();
         assert_eq!(nd.forward, again.forward);
+        let key = PatternKey::of(a.symbolic());
+        assert_eq!(cache::get(&key).unwrap().forward, nd.forward);
+        // another pattern of the same size and entries count is another key
+        let b = laplacian(24, 30, 30);
+        assert_eq!((b.nrows(), b.compute_nnz()), (n, a.compute_nnz()));
+        assert_ne!(PatternKey::of(b.symbolic()), key);
+        let nb = FillOrdering::of(b.symbolic()).unwrap().unwrap();
+        assert_ne!(nb.forward, nd.forward);
         let (with_nd, with_amd) = (fill(&a, Some(&nd)), fill(&a, None));
         assert!(
             with_nd < with_amd,

@@ -1,8 +1,9 @@
 //! Projection of every part of a frictional operator on a basis (`V^T X V`,
 //! [`project`]) and expansion of reduced vectors (`u = V q`, [`expand`]).
 
-use super::{par, sparse_times, tmul};
+use super::{par, tmul};
 use crate::contact::FrictionalOperator;
+use crate::linalg::sparse_transpose_times;
 use crate::{c64, Error, Result, SparseMat, SparseRef};
 use faer::linalg::matmul::matmul;
 use faer::sparse::Triplet;
@@ -38,7 +39,8 @@ pub(super) fn project_part(x: SparseRef<'_>, v: MatRef<'_, f64>) -> Result<Spars
         return dense_to_sparse(Mat::<f64>::zeros(m, m).as_ref());
     }
     let red = if rows.len() == n {
-        tmul(v, sparse_times(x, v).as_ref())
+        // V^T X V = (X^T V)^T V: the gather product, no symmetry of X assumed
+        tmul(sparse_transpose_times(x, v).as_ref(), v)
     } else {
         // only the rows X touches: (X V)[rows, :], summed over the columns of X in the
         // same order as `sparse_times`, so the same bits without an n x m product
