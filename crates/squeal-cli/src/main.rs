@@ -13,7 +13,9 @@ mod stability;
 mod study;
 mod study_charts;
 mod study_flags;
+mod study_progress;
 mod sweep;
+mod sweep_charts;
 mod validate;
 
 use anyhow::Result;

@@ -5,15 +5,12 @@
 //! (`study_charts`).
 
 use anyhow::{Context, Result};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use squeal_analysis::study::{
-    self, parse_list, parse_region, Axis, MacroSpec, MesoSpec, Progress, RunOptions, Shard,
-    SolveSpec, StudyDef, StudyDir, StudySpec, Summary,
+    self, parse_list, parse_region, Axis, MacroSpec, MesoSpec, RunOptions, Shard, SolveSpec,
+    StudyDef, StudyDir, StudySpec, Summary,
 };
 use squeal_core::Registry;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use std::time::Instant;
 
 /// The paper's patch sides (m), `paper-data.toml` `[mesoscopic.coupling_2]` (2100 Hz).
@@ -260,7 +257,7 @@ fn execute(
             .map(|s| format!(" (shard {}/{})", s.k, s.n))
             .unwrap_or_default()
     );
-    let bar = Bar::new();
+    let bar = crate::study_progress::Bar::new();
     let dir = StudyDir::new(out);
     let report = study::run(registry, &model, &def, &dir, &opts, &|p| bar.update(p))
         .map_err(crate::study_flags::flags)?;
@@ -404,92 +401,6 @@ fn print_summary(s: &Summary) {
             );
         }
     }
-}
-
-/// The progress display: an indicatif bar on a terminal, one line per case otherwise
-/// (hidden bar when stderr is not a terminal or `CI=true`).
-struct Bar {
-    bar: ProgressBar,
-    visible: bool,
-    state: Mutex<(usize, usize, Instant)>,
-}
-
-impl Bar {
-    fn new() -> Self {
-        let ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
-        let visible = std::io::stderr().is_terminal() && !ci;
-        let bar = ProgressBar::new(0);
-        if visible {
-            bar.set_style(
-                ProgressStyle::with_template(
-                    "{bar:30} {pos}/{len} cases  {per_sec}  ETA {eta}  {msg}",
-                )
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-            );
-        } else {
-            bar.set_draw_target(ProgressDrawTarget::hidden());
-        }
-        Self {
-            bar,
-            visible,
-            state: Mutex::new((0, 0, Instant::now())),
-        }
-    }
-
-    fn update(&self, p: Progress<'_>) {
-        let mut st = self.state.lock().unwrap_or_else(|e| e.into_inner());
-        match p {
-            Progress::Start {
-                resumed,
-                todo,
-                shard,
-            } => {
-                *st = (resumed, todo, Instant::now());
-                self.bar.set_length(todo as u64);
-                self.bar.reset_eta();
-                if resumed > 0 {
-                    eprintln!("resuming: {resumed} of {shard} cases already done, {todo} to run");
-                }
-            }
-            Progress::Case { done, record } => {
-                let unstable: Vec<String> = record
-                    .unstable
-                    .iter()
-                    .map(|m| format!("{:.0} Hz DvR {:.4}", m.freq_hz, m.dvr))
-                    .collect();
-                let what = match &record.error {
-                    Some(e) => format!("FAILED: {e}"),
-                    None if unstable.is_empty() => "stable".into(),
-                    None => unstable.join(", "),
-                };
-                if self.visible {
-                    self.bar.set_position(done as u64);
-                    self.bar.set_message(format!("{}: {what}", record.case.id));
-                } else {
-                    let (_, todo, t0) = *st;
-                    let el = t0.elapsed().as_secs_f64();
-                    let rate = done as f64 / el.max(1e-9);
-                    let eta = (todo - done.min(todo)) as f64 / rate.max(1e-12);
-                    eprintln!(
-                        "[{done}/{todo}] {} ({} pairs): {what}  ({:.2} cases/min, ETA {})",
-                        record.case.id,
-                        record.case.pairs,
-                        rate * 60.0,
-                        hms(eta)
-                    );
-                }
-            }
-        }
-    }
-
-    fn finish(&self) {
-        self.bar.finish_and_clear();
-    }
-}
-
-fn hms(s: f64) -> String {
-    let s = s.round() as u64;
-    format!("{}:{:02}:{:02}", s / 3600, (s / 60) % 60, s % 60)
 }
 
 /// `squeal merge` inputs: each must be a study directory.

@@ -3,7 +3,6 @@
 //! param`: the same for the parameter of a parametric operator directory.
 
 use anyhow::Result;
-use squeal_analysis::family::SweepCoupling;
 use squeal_analysis::mu_sweep::{
     mu_list, run_into, value_list, MuSweep, MuSweepSettings, SweepEvent, SweepSummary,
 };
@@ -11,7 +10,6 @@ use squeal_analysis::outdir::RunError;
 use squeal_analysis::param_sweep::ParamSweepSettings;
 use squeal_analysis::pipeline::Prepared;
 use squeal_analysis::profile::Profile;
-use squeal_analysis::sweep::{Branch, SweepPoint};
 use squeal_core::Registry;
 use std::path::{Path, PathBuf};
 
@@ -252,9 +250,9 @@ impl ParamArgs {
             ),
             e => crate::opts::out_error(e),
         })?;
-        let axis = Axis::param(name);
-        charts(out, &axis, &sweep.points, &sweep.branches, dvr_tol)?;
-        mac_charts(out, &axis, &sweep.couplings)?;
+        let axis = crate::sweep_charts::Axis::param(name);
+        crate::sweep_charts::charts(out, &axis, &sweep.points, &sweep.branches, dvr_tol)?;
+        crate::sweep_charts::mac_charts(out, &axis, &sweep.couplings)?;
         println!(
             "{} points of {name} at mu = {}, {} couplings, max backward error {:.1e}, max \
              error bound {}, {:.1} s",
@@ -373,7 +371,7 @@ pub fn run_on(
         report_event(&mut eta, out, prep, dvr_tol, e)
     })
     .map_err(crate::opts::out_error)?;
-    sweep_charts(out, &sweep, dvr_tol)?;
+    crate::sweep_charts::sweep_charts(out, &sweep, dvr_tol)?;
     let profile = Profile {
         stages: summary.stages.clone(),
     };
@@ -425,129 +423,4 @@ pub fn report_event(
             );
         }
     }
-}
-
-/// The charts of a finished mu sweep: frequency and DvR against mu (Figure 5), and the
-/// make-up of each coupling.
-pub fn sweep_charts(out: &Path, sweep: &MuSweep, dvr_tol: f64) -> Result<()> {
-    charts(out, &Axis::mu(), &sweep.points, &sweep.branches, dvr_tol)?;
-    let makeup: Vec<SweepCoupling> = sweep
-        .couplings
-        .iter()
-        .map(|c| SweepCoupling {
-            freq_hz: c.freq_hz,
-            from: c.mu_from,
-            to: c.mu_to,
-            max_dvr: c.max_dvr,
-            partners: c.partners.clone(),
-            makeup: c.free_interface_mac.clone(),
-        })
-        .collect();
-    mac_charts(out, &Axis::mu(), &makeup)
-}
-
-/// The swept quantity of charts and CSV: its column name, its axis label and the modes
-/// the signatures are taken on (one of them, and all of them).
-struct Axis {
-    column: String,
-    label: String,
-    item: &'static str,
-    reference: &'static str,
-}
-
-impl Axis {
-    fn mu() -> Self {
-        Self {
-            column: "mu".into(),
-            label: "friction coefficient mu".into(),
-            item: "free-interface mode",
-            reference: "the free-interface modes",
-        }
-    }
-
-    fn param(name: &str) -> Self {
-        Self {
-            column: name.into(),
-            label: format!("parameter {name}"),
-            item: "reference mode",
-            reference: "the reference modes",
-        }
-    }
-}
-
-fn charts(
-    out: &Path,
-    axis: &Axis,
-    points: &[SweepPoint],
-    branches: &[Branch],
-    tol: f64,
-) -> Result<Vec<PathBuf>> {
-    use squeal_plot::{line_chart, ChartOptions, Series, SeriesStyle};
-    let series = |y: &dyn Fn(&squeal_analysis::sweep::SweepMode) -> f64| -> Vec<Series> {
-        branches
-            .iter()
-            .map(|b| {
-                let pts: Vec<(usize, usize)> = (0..points.len())
-                    .filter_map(|p| b.modes[p].map(|m| (p, m)))
-                    .collect();
-                Series {
-                    name: String::new(),
-                    points: pts
-                        .iter()
-                        .map(|&(p, m)| (points[p].value, y(&points[p].modes[m])))
-                        .collect(),
-                    style: SeriesStyle::LineMarkers,
-                    highlight: pts
-                        .iter()
-                        .map(|&(p, m)| points[p].modes[m].dvr > tol)
-                        .collect(),
-                }
-            })
-            .collect()
-    };
-    let mut files = line_chart(
-        &out.join(format!("frequency_vs_{}", axis.column)),
-        "Frequency of the tracked modes (unstable in red)",
-        &axis.label,
-        "frequency (Hz)",
-        &series(&|m| m.freq_hz),
-        &ChartOptions {
-            highlight_label: Some("unstable".into()),
-            ..ChartOptions::default()
-        },
-    )?;
-    files.extend(line_chart(
-        &out.join(format!("dvr_vs_{}", axis.column)),
-        "Divergence rate Re/Im of the tracked modes (unstable in red)",
-        &axis.label,
-        "DvR = Re(lambda)/Im(lambda)",
-        &series(&|m| m.dvr),
-        &ChartOptions {
-            hline: Some(0.0),
-            highlight_label: Some("unstable".into()),
-            ..ChartOptions::default()
-        },
-    )?);
-    Ok(files)
-}
-
-/// One bar chart per coupling: the MAC of the unstable mode with the reference modes of
-/// the signatures.
-fn mac_charts(out: &Path, axis: &Axis, couplings: &[SweepCoupling]) -> Result<()> {
-    for (i, c) in couplings.iter().enumerate() {
-        if c.makeup.is_empty() {
-            continue;
-        }
-        squeal_plot::bar_chart(
-            &out.join(format!("mac_coupling_{}", i + 1)),
-            &format!(
-                "Unstable mode near {:.0} Hz ({} {}-{}): MAC with {}",
-                c.freq_hz, axis.column, c.from, c.to, axis.reference
-            ),
-            axis.item,
-            "MAC",
-            &c.makeup,
-        )?;
-    }
-    Ok(())
 }

@@ -193,7 +193,8 @@ impl ValidateHooks for Hooks {
         _summary: &SweepSummary,
         sweep: &MuSweep,
     ) -> Result<(), RunError> {
-        crate::sweep::sweep_charts(out, sweep, 1e-6).map_err(|e| RunError::Output(format!("{e:#}")))
+        crate::sweep_charts::sweep_charts(out, sweep, 1e-6)
+            .map_err(|e| RunError::Output(format!("{e:#}")))
     }
 }
 

@@ -44,6 +44,7 @@ use plotters::prelude::*;
 use plotters::style::FontStyle;
 
 mod bar;
+mod colormap;
 mod contact;
 mod line;
 mod pareto;

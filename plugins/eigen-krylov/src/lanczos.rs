@@ -1,5 +1,6 @@
 //! Thick-restart Lanczos in the `M` inner product (the crate docs give the method).
 
+use super::pairs::Pairs;
 use super::{
     par_for, Directions, BREAKDOWN, CHECK_EVERY, NEW_DIRECTION_MIN, NEW_DIRECTION_TRIES, THIRD_PASS,
 };
@@ -58,90 +59,6 @@ pub(crate) fn largest_from(
         found = Pairs::merged(&found, &above, nev);
         if !check.complete {
             return Ok(found.into_output(ctx.restarts, false));
-        }
-    }
-}
-
-/// Converged eigenpairs of `OP`: values, `M`-orthonormal vectors and `M` times them.
-pub(crate) struct Pairs {
-    pub(crate) n: usize,
-    pub(crate) theta: Vec<f64>,
-    pub(crate) x: Vec<f64>,
-    pub(crate) mx: Vec<f64>,
-}
-
-impl Pairs {
-    pub(crate) fn new(n: usize) -> Self {
-        Self {
-            n,
-            theta: Vec::new(),
-            x: Vec::new(),
-            mx: Vec::new(),
-        }
-    }
-
-    fn len(&self) -> usize {
-        self.theta.len()
-    }
-
-    fn push(&mut self, theta: f64, x: &[f64], mx: &[f64]) {
-        self.theta.push(theta);
-        self.x.extend_from_slice(x);
-        self.mx.extend_from_slice(mx);
-    }
-
-    fn x(&self, j: usize) -> &[f64] {
-        &self.x[j * self.n..(j + 1) * self.n]
-    }
-
-    fn mx(&self, j: usize) -> &[f64] {
-        &self.mx[j * self.n..(j + 1) * self.n]
-    }
-
-    fn x_mat(&self) -> MatRef<'_, f64> {
-        MatRef::from_column_major_slice(&self.x, self.n, self.len())
-    }
-
-    fn mx_mat(&self) -> MatRef<'_, f64> {
-        MatRef::from_column_major_slice(&self.mx, self.n, self.len())
-    }
-
-    fn min_theta(&self) -> f64 {
-        self.theta.iter().copied().fold(f64::INFINITY, f64::min)
-    }
-
-    fn filtered(&self, keep: impl Fn(f64) -> bool) -> Self {
-        let mut out = Self::new(self.n);
-        for j in 0..self.len() {
-            if keep(self.theta[j]) {
-                out.push(self.theta[j], self.x(j), self.mx(j));
-            }
-        }
-        out
-    }
-
-    /// The `count` largest pairs of `a` and `b` (mutually `M`-orthogonal sets).
-    fn merged(a: &Self, b: &Self, count: usize) -> Self {
-        let mut all: Vec<(f64, &Self, usize)> = (0..a.len())
-            .map(|j| (a.theta[j], a, j))
-            .chain((0..b.len()).map(|j| (b.theta[j], b, j)))
-            .collect();
-        all.sort_by(|p, q| q.0.total_cmp(&p.0));
-        let mut out = Self::new(a.n);
-        for &(t, set, j) in all.iter().take(count) {
-            out.push(t, set.x(j), set.mx(j));
-        }
-        out
-    }
-
-    fn into_output(self, iterations: usize, all_converged: bool) -> KernelOutput {
-        let n = self.n;
-        let vectors = Mat::from_fn(n, self.len(), |i, j| self.x[j * n + i]);
-        KernelOutput {
-            theta: self.theta,
-            vectors,
-            iterations,
-            all_converged,
         }
     }
 }

@@ -121,13 +121,16 @@ use squeal_core::{
 };
 
 mod lanczos;
+mod pairs;
 pub mod schur;
 #[cfg(test)]
 mod tests;
 
 use lanczos::largest_from;
 #[cfg(test)]
-use lanczos::{Ctx, Pairs};
+use lanczos::Ctx;
+#[cfg(test)]
+use pairs::Pairs;
 pub use schur::KrylovSchurKernel;
 
 /// Name under which the solver is registered.

@@ -64,18 +64,13 @@ impl CalibrationSpec {
         Ok(())
     }
 
-    pub(super) fn check(&self, file: &str) -> Result<(), SpecError> {
+    /// The parameters' bounds, scales, starts and paths (each given once).
+    fn check_parameters(&self, file: &str) -> Result<(), SpecError> {
         let field = |f: String, message: String| SpecError::Field {
             file: file.into(),
             field: f,
             message,
         };
-        if self.targets.is_empty() {
-            return Err(field(
-                "target".into(),
-                "expected at least one [[target]]".into(),
-            ));
-        }
         for (i, p) in self.parameters.iter().enumerate() {
             let f = |name: &str| format!("parameter[{i}].{name}");
             if !(p.min.is_finite() && p.max.is_finite() && p.min < p.max) {
@@ -105,6 +100,22 @@ impl CalibrationSpec {
                 return Err(field(f("path"), format!("`{}` is given twice", p.path)));
             }
         }
+        Ok(())
+    }
+
+    pub(super) fn check(&self, file: &str) -> Result<(), SpecError> {
+        let field = |f: String, message: String| SpecError::Field {
+            file: file.into(),
+            field: f,
+            message,
+        };
+        if self.targets.is_empty() {
+            return Err(field(
+                "target".into(),
+                "expected at least one [[target]]".into(),
+            ));
+        }
+        self.check_parameters(file)?;
         for (i, t) in self.targets.iter().enumerate() {
             let f = |name: &str| format!("target[{i}].{name}");
             if !(t.within.is_finite() && (0.0..1.0).contains(&t.within)) {

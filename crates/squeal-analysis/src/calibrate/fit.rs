@@ -179,13 +179,7 @@ pub fn calibrate(
         let (best_z, stop) = run_search(problem, spec, z0)?;
         // the best point evaluated in this round (argmin's best, or the history's when
         // the budget stopped it)
-        let best = steps
-            .borrow()
-            .iter()
-            .filter(|s| s.round == round && s.kind != "confirm" && s.cost.is_finite())
-            .min_by(|a, b| a.cost.total_cmp(&b.cost))
-            .map(|s| s.values.clone());
-        values = match (best_z, best) {
+        values = match (best_z, best_of_round(&steps.borrow(), round)) {
             (_, Some(b)) => b,
             (Some(z), None) => to_values(spec, &z),
             (None, None) => values,
@@ -230,6 +224,15 @@ pub fn calibrate(
         dofs,
         time_s: start_time.elapsed().as_secs_f64(),
     })
+}
+
+/// The values of the cheapest finite search step of `round`.
+fn best_of_round(steps: &[Step], round: usize) -> Option<Vec<f64>> {
+    steps
+        .iter()
+        .filter(|s| s.round == round && s.kind != "confirm" && s.cost.is_finite())
+        .min_by(|a, b| a.cost.total_cmp(&b.cost))
+        .map(|s| s.values.clone())
 }
 
 /// The correction ratio of each target: its value on the scene's own rule over its value

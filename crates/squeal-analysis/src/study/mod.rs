@@ -28,6 +28,7 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 mod cases;
+mod dir;
 mod input;
 mod run;
 mod spec;
@@ -36,10 +37,9 @@ mod summary;
 mod tests;
 
 pub use cases::derive_seed;
+pub use dir::{merge, StudyDir};
 pub use input::{parse_list, parse_region, Axis, Shard};
-pub use run::{
-    merge, run, run_case, Progress, Record, RunOptions, RunReport, StudyDir, Timing, UnstableMode,
-};
+pub use run::{run, run_case, Progress, Record, RunOptions, RunReport, Timing, UnstableMode};
 pub use spec::{
     Case, CaseList, GridInfo, MacroSpec, MesoSpec, Skipped, SolveSpec, StudyDef, StudySpec,
 };

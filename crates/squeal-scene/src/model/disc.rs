@@ -74,21 +74,7 @@ pub(super) fn generated(asm: &mut Assembly<'_>, lay: &Layout) -> Result<()> {
     } = lay;
     let d = scene.disc.as_ref().ok_or_else(|| cx.missing("disc"))?;
     let m = cx.material(&d.material, "disc.material")?;
-    if let (Some(pa), Some((_, im))) = (&patch, &pin_import) {
-        let (x0, x1) = (pa.xs[0], pa.xs[pa.xs.len() - 1]);
-        if (x0 + x1).abs() > 1e-9 * (x1 - x0) {
-            return Err(cx.group_error(
-                "pin",
-                "contact_group",
-                format!(
-                    "the generated disc reproduces the pin face centred on x = 0, but the \
-                     pin face of {} spans x in [{x0:e}, {x1:e}] m; centre it on x = 0 or \
-                     import the disc mesh too",
-                    im.path.display()
-                ),
-            ));
-        }
-    }
+    check_centred_face(&cx, patch, pin_import)?;
     let (lambda, h) = element_size(
         m.as_ref(),
         d.thickness_m,
@@ -211,6 +197,27 @@ pub(super) fn generated(asm: &mut Assembly<'_>, lay: &Layout) -> Result<()> {
     sizes.extend(hat_rule);
     materials.push(m);
     body_names.push("disc".to_string());
+    Ok(())
+}
+
+/// A generated disc reproduces the pin face centred on `x = 0`: an imported pin's face
+/// must be centred there.
+fn check_centred_face(cx: &Context<'_>, patch: &Option<Patch>, pin_import: &Import) -> Result<()> {
+    if let (Some(pa), Some((_, im))) = (patch, pin_import) {
+        let (x0, x1) = (pa.xs[0], pa.xs[pa.xs.len() - 1]);
+        if (x0 + x1).abs() > 1e-9 * (x1 - x0) {
+            return Err(cx.group_error(
+                "pin",
+                "contact_group",
+                format!(
+                    "the generated disc reproduces the pin face centred on x = 0, but the \
+                     pin face of {} spans x in [{x0:e}, {x1:e}] m; centre it on x = 0 or \
+                     import the disc mesh too",
+                    im.path.display()
+                ),
+            ));
+        }
+    }
     Ok(())
 }
 

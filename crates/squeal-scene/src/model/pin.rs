@@ -77,20 +77,8 @@ pub(super) fn generated(asm: &mut Assembly<'_>, lay: &Layout) -> Result<()> {
     .into_iter()
     .filter_map(|(n, p)| p.as_ref().map(|p| (n, p)))
     .collect();
-    let mut plate_mats = Vec::new();
-    let mut h_plate = f64::INFINITY;
-    for (name, pl) in &plates {
-        let m = cx.material(&pl.material, &format!("{name}.material"))?;
-        let (lambda, h) = element_size(
-            m.as_ref(),
-            pl.thickness_m,
-            rule.max_freq_hz,
-            rule.plate_elements_per_wavelength
-                .unwrap_or(rule.elements_per_wavelength),
-        );
-        h_plate = h_plate.min(h);
-        plate_mats.push((m, lambda, h));
-    }
+    let plate_mats = plate_materials(&cx, &plates)?;
+    let h_plate = plate_mats.iter().map(|p| p.2).fold(f64::INFINITY, f64::min);
     let pa = patch.as_ref().expect("a pin has a patch");
     // common grid lines in x and y: the pin face's contact grid, plates graded away
     // from it; the plates' grids contain the pin's, so glued faces conform
@@ -197,6 +185,28 @@ pub(super) fn generated(asm: &mut Assembly<'_>, lay: &Layout) -> Result<()> {
         z += pl.thickness_m;
     }
     Ok(())
+}
+
+/// Each plate's material with the wavelength and element size the mesh rule gives it.
+#[allow(clippy::type_complexity)]
+fn plate_materials(
+    cx: &Context<'_>,
+    plates: &[(&str, &crate::Plate)],
+) -> Result<Vec<(Box<dyn squeal_core::Material>, f64, f64)>> {
+    let rule = &cx.scene.mesh;
+    let mut out = Vec::new();
+    for (name, pl) in plates {
+        let m = cx.material(&pl.material, &format!("{name}.material"))?;
+        let (lambda, h) = element_size(
+            m.as_ref(),
+            pl.thickness_m,
+            rule.max_freq_hz,
+            rule.plate_elements_per_wavelength
+                .unwrap_or(rule.elements_per_wavelength),
+        );
+        out.push((m, lambda, h));
+    }
+    Ok(out)
 }
 
 /// The grid lines in x and y of the plates: the pin face's contact grid `pa`, graded away
