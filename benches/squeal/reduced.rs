@@ -2,12 +2,15 @@
 //!
 //! * `projection/m<M>/<dofs>`: [`squeal::core::reduction::project`] of the whole frictional
 //!   operator (`M_c`, `K_c`, `F_M`, `F_K`) on a dense `n x M` basis, `X_r = V^T X V`
-//!   (faer sparse-times-dense, then a dense `V^T (X V)`; the friction parts touch only the
-//!   rows of the contact DOFs), `M` = 100 and 300, at every rig size;
-//! * `sparse_times/{squeal,faer}/m<M>/<dofs>`: `M_c V` on the same `n x M` basis by
-//!   [`squeal::core::linalg::sparse_times`] (column blocks, parallel) and by faer 0.24's
-//!   `sparse_dense_matmul` (serial, one pass over `M_c` per column), which it replaced in the
-//!   projection, the orthonormalization and the synthesis (both give the same bits);
+//!   (the gather product `X^T V`, then a dense `(X^T V)^T V`; the friction parts touch only
+//!   the rows of the contact DOFs), `M` = 100 and 300, at every rig size;
+//! * `sparse_times/{squeal,gather,faer}/m<M>/<dofs>`: `M_c V` on the same `n x M` basis by
+//!   [`squeal::core::linalg::sparse_times`] (column blocks, parallel, scattered into the
+//!   rows), by [`squeal::core::linalg::sparse_transpose_times`] (the same blocks, each
+//!   entry gathered from one column: `M_c^T V = M_c V` for the symmetric `M_c`; the
+//!   projection's product) and by faer 0.24's `sparse_dense_matmul` (serial, one pass over
+//!   `M_c` per column), which the first replaced in the orthonormalization and the
+//!   synthesis (both give the same bits);
 //! * `dense_qep/<m>`: [`dense_qep`] on a reduced QEP of size `m` = 100, 200, 400 (the
 //!   smallest rig's operator at `mu = 0.7` projected on `m` columns): scaled companion form
 //!   of size `2m`, one dense LU of `M_r`, faer's real non-symmetric eigendecomposition.
@@ -19,7 +22,7 @@ use crate::rig::{pseudo_random, Rigs, MU};
 use criterion::{BenchmarkId, Criterion, SamplingMode};
 use squeal::core::faer::sparse::linalg::matmul::sparse_dense_matmul;
 use squeal::core::faer::{Accum, Mat, Par};
-use squeal::core::linalg::sparse_times;
+use squeal::core::linalg::{sparse_times, sparse_transpose_times};
 use squeal::core::qep::dense_qep;
 use squeal::core::reduction::project;
 use std::time::Duration;
@@ -47,7 +50,8 @@ pub fn bench_projection(c: &mut Criterion, rigs: &Rigs) {
     group.finish();
 }
 
-/// `M_c V` by squeal's blocked product and by faer's, at every rig size and basis size.
+/// `M_c V` by squeal's blocked scatter and gather products and by faer's, at every rig
+/// size and basis size.
 pub fn bench_sparse_times(c: &mut Criterion, rigs: &Rigs) {
     let mut group = c.benchmark_group("sparse_times");
     group.sampling_mode(SamplingMode::Flat);
@@ -61,6 +65,11 @@ pub fn bench_sparse_times(c: &mut Criterion, rigs: &Rigs) {
                 BenchmarkId::new(format!("squeal/m{m}"), r.dofs()),
                 &v,
                 |b, v| b.iter(|| sparse_times(mc, v.as_ref())),
+            );
+            group.bench_with_input(
+                BenchmarkId::new(format!("gather/m{m}"), r.dofs()),
+                &v,
+                |b, v| b.iter(|| sparse_transpose_times(mc, v.as_ref())),
             );
             group.bench_with_input(
                 BenchmarkId::new(format!("faer/m{m}"), r.dofs()),

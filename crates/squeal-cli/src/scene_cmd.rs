@@ -42,7 +42,7 @@ impl SceneCmd {
 /// Measured wall times of `squeal validate` on a 2-core machine, `(free DOFs, seconds)`:
 /// the embedded `pin-on-disc-coarse` and `pin-on-disc` scenes. They calibrate
 /// [`validate_estimate_s`].
-const VALIDATE_RUNS: [(f64, f64); 2] = [(1_779.0, 3.7), (171_963.0, 949.0)];
+const VALIDATE_RUNS: [(f64, f64); 2] = [(1_779.0, 2.4), (171_963.0, 725.0)];
 
 /// Exponent of the power law `t = t0 (n / n0)^p` through the two [`VALIDATE_RUNS`].
 fn validate_exponent() -> f64 {
