@@ -53,19 +53,7 @@ pub fn build_operator(
     for i in (0..set.len()).filter(|&i| active[i]) {
         partner[set.pin_dofs[i][2]] = Some(set.disc_dofs[i][2]);
     }
-    let mut t = vec![usize::MAX; n];
-    let mut nc = 0;
-    for j in 0..n {
-        if partner[j].is_none() {
-            t[j] = nc;
-            nc += 1;
-        }
-    }
-    for j in 0..n {
-        if let Some(p) = partner[j] {
-            t[j] = t[p];
-        }
-    }
+    let (t, nc) = index_map(&partner);
     let relabel = |x: SparseRef<'_>| -> Result<SparseMat> { Ok(relabel(x, &t, nc)) };
     let friction = |x: SparseRef<'_>| -> Result<SparseMat> {
         let mut trip = Vec::new();
@@ -117,6 +105,27 @@ pub fn build_operator(
         t: Some(t),
         friction_loads: Some(friction_loads),
     })
+}
+
+/// The index map `T` of the eliminated DOFs (`partner[j]`: the DOF that DOF `j` is tied
+/// to, itself kept): the kept DOFs numbered in order, each eliminated one onto its
+/// partner's number. Returns the map and the number of constrained DOFs.
+fn index_map(partner: &[Option<usize>]) -> (Vec<usize>, usize) {
+    let n = partner.len();
+    let mut t = vec![usize::MAX; n];
+    let mut nc = 0;
+    for j in 0..n {
+        if partner[j].is_none() {
+            t[j] = nc;
+            nc += 1;
+        }
+    }
+    for j in 0..n {
+        if let Some(p) = partner[j] {
+            t[j] = t[p];
+        }
+    }
+    (t, nc)
 }
 
 /// `T^T X T` for the index map `t` onto `nc` constrained DOFs: column `c` gathers the
@@ -177,19 +186,8 @@ mod tests {
         // 9 DOFs, DOF 2 onto 7's place and DOF 5 onto 0's: 7 constrained DOFs
         let n = 9;
         let partner = [None, None, Some(7), None, None, Some(0), None, None, None];
-        let mut t = vec![0usize; n];
-        let mut nc = 0;
-        for j in 0..n {
-            if partner[j].is_none() {
-                t[j] = nc;
-                nc += 1;
-            }
-        }
-        for j in 0..n {
-            if let Some(p) = partner[j] {
-                t[j] = t[p];
-            }
-        }
+        let (t, nc) = index_map(&partner);
+        assert_eq!((nc, t[2], t[5], t[8]), (7, t[7], t[0], 6));
         let mut trip = Vec::new();
         for j in 0..n {
             for i in 0..n {

@@ -87,22 +87,7 @@ pub fn add_scaled(a: SparseRef<'_>, alpha: f64, b: SparseRef<'_>, beta: f64) -> 
 /// # Panics
 /// If `A` has not as many columns as `X` rows (a programming error, as in faer).
 pub fn sparse_times(a: SparseRef<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
-    assert_eq!(
-        a.ncols(),
-        x.nrows(),
-        "sparse_times: A has {} columns but X {} rows",
-        a.ncols(),
-        x.nrows()
-    );
-    let mut y = Mat::<f64>::zeros(a.nrows(), x.ncols());
-    if a.nrows() > 0 && x.ncols() > 0 {
-        match x.ncols() {
-            c if c >= 12 => sparse_times_blocks::<16>(a, x, y.as_mut()),
-            c if c >= 5 => sparse_times_blocks::<8>(a, x, y.as_mut()),
-            _ => sparse_times_blocks::<4>(a, x, y.as_mut()),
-        }
-    }
-    y
+    product(a, x, Product::Scatter)
 }
 
 /// `A^T X` for a sparse `A` (CSC) and a dense `X`: every entry is a gather over one
@@ -114,47 +99,62 @@ pub fn sparse_times(a: SparseRef<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
 /// # Panics
 /// If `A` has not as many rows as `X` (a programming error, as in faer).
 pub fn sparse_transpose_times(a: SparseRef<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
+    product(a, x, Product::Gather)
+}
+
+/// The two products by blocks of columns of `X`.
+#[derive(Clone, Copy)]
+enum Product {
+    /// `A X`, each column of `A` scattered into the rows of the block.
+    Scatter,
+    /// `A^T X`, each entry gathered from one column of `A`.
+    Gather,
+}
+
+/// `A X` or `A^T X` ([`Product`]), checked for sizes.
+fn product(a: SparseRef<'_>, x: MatRef<'_, f64>, product: Product) -> Mat<f64> {
+    let (name, inner, outer) = match product {
+        Product::Scatter => ("sparse_times: A has {} columns", a.ncols(), a.nrows()),
+        Product::Gather => (
+            "sparse_transpose_times: A has {} rows",
+            a.nrows(),
+            a.ncols(),
+        ),
+    };
     assert_eq!(
-        a.nrows(),
+        inner,
         x.nrows(),
-        "sparse_transpose_times: A has {} rows but X {}",
-        a.nrows(),
+        "{} but X {} rows",
+        name.replace("{}", &inner.to_string()),
         x.nrows()
     );
-    let mut y = Mat::<f64>::zeros(a.ncols(), x.ncols());
-    if a.ncols() > 0 && x.ncols() > 0 {
-        match x.ncols() {
-            c if c >= 12 => gather_blocks::<16>(a, x, y.as_mut()),
-            c if c >= 5 => gather_blocks::<8>(a, x, y.as_mut()),
-            _ => gather_blocks::<4>(a, x, y.as_mut()),
-        }
+    let mut y = Mat::<f64>::zeros(outer, x.ncols());
+    if outer > 0 && x.ncols() > 0 {
+        blocked(a, x, y.as_mut(), product);
     }
     y
 }
 
-/// [`sparse_transpose_times`] by blocks of `W` columns of `X` (the last one padded).
-fn gather_blocks<const W: usize>(a: SparseRef<'_>, x: MatRef<'_, f64>, y: MatMut<'_, f64>) {
-    let block = |c0: usize, mut yb: MatMut<'_, f64>| {
-        let b = yb.ncols();
-        // the block of X row by row, W values per row
-        let mut xt = vec![[0.0f64; W]; a.nrows()];
-        for t in 0..b {
-            for (i, &v) in x.col(c0 + t).iter().enumerate() {
-                xt[i][t] = v;
-            }
-        }
-        for j in 0..a.ncols() {
-            let mut acc = [0.0f64; W];
-            for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
-                let xi = &xt[i];
-                for t in 0..W {
-                    acc[t] += v * xi[t];
-                }
-            }
-            for (t, &v) in acc.iter().enumerate().take(b) {
-                yb[(j, t)] = v;
-            }
-        }
+/// `y <- A X` or `A^T X` ([`Product`]) with the columns of `X` in blocks of 16, 8 or 4.
+fn blocked(a: SparseRef<'_>, x: MatRef<'_, f64>, y: MatMut<'_, f64>, product: Product) {
+    match x.ncols() {
+        c if c >= 12 => by_blocks::<16>(a, x, y, product),
+        c if c >= 5 => by_blocks::<8>(a, x, y, product),
+        _ => by_blocks::<4>(a, x, y, product),
+    }
+}
+
+/// [`blocked`] for blocks of `W` columns of `X` (the last one padded with zeros), the
+/// blocks in parallel under faer's global parallelism.
+fn by_blocks<const W: usize>(
+    a: SparseRef<'_>,
+    x: MatRef<'_, f64>,
+    y: MatMut<'_, f64>,
+    product: Product,
+) {
+    let block = |c0: usize, yb: MatMut<'_, f64>| match product {
+        Product::Scatter => scatter_block::<W>(a, x, c0, yb),
+        Product::Gather => gather_block::<W>(a, x, c0, yb),
     };
     match faer::get_global_parallelism() {
         Par::Seq => {
@@ -173,45 +173,61 @@ fn gather_blocks<const W: usize>(a: SparseRef<'_>, x: MatRef<'_, f64>, y: MatMut
     }
 }
 
-/// [`sparse_times`] by blocks of `W` columns of `X` (the last one padded with zeros).
-fn sparse_times_blocks<const W: usize>(a: SparseRef<'_>, x: MatRef<'_, f64>, y: MatMut<'_, f64>) {
-    let block = |c0: usize, mut yb: MatMut<'_, f64>| {
-        let b = yb.ncols();
-        // the block of X and of A X row by row, W values per row
-        let mut xt = vec![[0.0f64; W]; a.ncols()];
-        for t in 0..b {
-            for (j, &v) in x.col(c0 + t).iter().enumerate() {
-                xt[j][t] = v;
+/// The columns `c0..c0 + b` of `x` row by row, `W` values per row (zero-padded).
+fn interleaved<const W: usize>(x: MatRef<'_, f64>, c0: usize, b: usize) -> Vec<[f64; W]> {
+    let mut xt = vec![[0.0f64; W]; x.nrows()];
+    for t in 0..b {
+        for (i, &v) in x.col(c0 + t).iter().enumerate() {
+            xt[i][t] = v;
+        }
+    }
+    xt
+}
+
+/// `yb <- A X[:, c0..]`: every column of `A` scattered into the rows of the block.
+fn scatter_block<const W: usize>(
+    a: SparseRef<'_>,
+    x: MatRef<'_, f64>,
+    c0: usize,
+    mut yb: MatMut<'_, f64>,
+) {
+    let b = yb.ncols();
+    let xt = interleaved::<W>(x, c0, b);
+    let mut yt = vec![[0.0f64; W]; a.nrows()];
+    for (j, xj) in xt.iter().enumerate() {
+        for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+            let yi = &mut yt[i];
+            for t in 0..W {
+                yi[t] += v * xj[t];
             }
         }
-        let mut yt = vec![[0.0f64; W]; a.nrows()];
-        for (j, xj) in xt.iter().enumerate() {
-            for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
-                let yi = &mut yt[i];
-                for t in 0..W {
-                    yi[t] += v * xj[t];
-                }
+    }
+    for t in 0..b {
+        for (yv, yi) in yb.as_mut().col_mut(t).iter_mut().zip(&yt) {
+            *yv = yi[t];
+        }
+    }
+}
+
+/// `yb <- A^T X[:, c0..]`: every entry gathered from one column of `A`.
+fn gather_block<const W: usize>(
+    a: SparseRef<'_>,
+    x: MatRef<'_, f64>,
+    c0: usize,
+    mut yb: MatMut<'_, f64>,
+) {
+    let b = yb.ncols();
+    let xt = interleaved::<W>(x, c0, b);
+    for j in 0..a.ncols() {
+        let mut acc = [0.0f64; W];
+        for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+            let xi = &xt[i];
+            for t in 0..W {
+                acc[t] += v * xi[t];
             }
         }
-        for t in 0..b {
-            for (yv, yi) in yb.as_mut().col_mut(t).iter_mut().zip(&yt) {
-                *yv = yi[t];
-            }
-        }
-    };
-    match faer::get_global_parallelism() {
-        Par::Seq => {
-            let mut y = y;
-            for c0 in (0..y.ncols()).step_by(W) {
-                let b = W.min(y.ncols() - c0);
-                block(c0, y.as_mut().subcols_mut(c0, b));
-            }
-        }
-        Par::Rayon(_) => {
-            use rayon::prelude::*;
-            y.par_col_chunks_mut(W)
-                .enumerate()
-                .for_each(|(k, yb)| block(k * W, yb))
+        for (t, &v) in acc.iter().enumerate().take(b) {
+            yb[(j, t)] = v;
         }
     }
 }
