@@ -10,7 +10,7 @@ pub fn spmv_complex(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
 }
 
 /// `y += A x` for a real sparse matrix and a complex vector.
-pub(crate) fn spmv_complex_add(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
+pub(super) fn spmv_complex_add(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
     debug_assert_eq!(x.len(), a.ncols());
     debug_assert_eq!(y.len(), a.nrows());
     for j in 0..a.ncols() {

@@ -9,7 +9,7 @@ use super::project::{dense_to_sparse, project_loads, project_part};
 use super::statics::{energy_norms, StaticSolver};
 use super::{expand, sparse_times, tmul};
 use crate::contact::FrictionalOperator;
-use crate::qep::vector::spmv_complex_add;
+use crate::qep::spmv_complex;
 use crate::{c64, Error, Result, SparseMat};
 use faer::{Mat, MatRef};
 
@@ -140,14 +140,10 @@ impl<'a> GrowingBasis<'a> {
         for (j, &l) in lambda.iter().enumerate() {
             let uj: Vec<c64> = (0..n).map(|r| u[(r, j)]).collect();
             // the friction parts: few nonzero rows, products on the vector
-            for (f, x) in [(&mut fm, Some(&op.fm)), (&mut fk, Some(&op.fk))]
-                .into_iter()
-                .chain([(&mut fc, op.fc.as_ref())])
-            {
-                f.iter_mut().for_each(|v| *v = zero);
-                if let Some(x) = x {
-                    spmv_complex_add(x.as_ref(), &uj, f);
-                }
+            spmv_complex(op.fm.as_ref(), &uj, &mut fm);
+            spmv_complex(op.fk.as_ref(), &uj, &mut fk);
+            if let Some(f) = &op.fc {
+                spmv_complex(f.as_ref(), &uj, &mut fc);
             }
             for r in 0..n {
                 // r = K~ u + l (C~ u + l M~ u),  X~ = X_c - mu F_X
