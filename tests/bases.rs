@@ -13,7 +13,7 @@
 
 use squeal::analysis::pipeline::{run_mu_sweep, Method, Prepared};
 use squeal::core::faer::{Mat, Side};
-use squeal::core::qep::ComplexModes;
+use squeal::core::operator::ComplexModes;
 use squeal::core::reduction::{
     friction_load_directions, m_orthonormality_error, m_orthonormalize, solve_reduced,
     sparse_times, StaticSolver, DEFAULT_RANK_TOL,

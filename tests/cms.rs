@@ -5,7 +5,7 @@
 
 use squeal::analysis::pipeline::{damped_operator, Method, Prepared};
 use squeal::contact::ContactSet;
-use squeal::core::qep::ComplexModes;
+use squeal::core::operator::ComplexModes;
 use squeal::core::{EigenParams, FrictionalOperator, Params, Registry};
 use squeal::scene::{Damping, Scene, Zone};
 use squeal_basis_cms::FreeInterface;

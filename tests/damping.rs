@@ -9,7 +9,7 @@
 //!   both.
 
 use squeal::analysis::pipeline::{damped_operator, Prepared};
-use squeal::core::qep::ComplexModes;
+use squeal::core::operator::ComplexModes;
 use squeal::core::{EigenParams, FrictionalOperator, Params};
 use squeal::scene::{Damping, Scene};
 

@@ -9,11 +9,10 @@
 
 use squeal::analysis::pipeline::Prepared;
 use squeal::core::faer::sparse::Triplet;
-use squeal::core::lowrank::{FrictionLowRank, QepLowRankSquared, SymmetricPencil, SymmetricShift};
-use squeal::core::qep::{
-    solve_frictional_band_with, ComplexLinOp, ComplexModes, LowRank, QepBandOptions,
-    QepSquaredShift,
-};
+use squeal::core::lowrank::{FrictionLowRank, SymmetricPencil, SymmetricShift};
+use squeal::core::operator::ComplexModes;
+use squeal::core::qep::{solve_frictional_band_with, LowRank, QepBandOptions};
+use squeal::core::spectral::{LinOp, SpectralTransform, SquaredShift};
 use squeal::core::{c64, EigenParams, FrictionalOperator, SparseMat};
 use squeal::scene::Scene;
 use std::sync::{Arc, OnceLock};
@@ -81,8 +80,8 @@ fn woodbury_vs_lu(op: &FrictionalOperator, pencil: &Arc<SymmetricPencil>, mu: f6
     let qep = op.at(mu).unwrap();
     let fr = FrictionLowRank::new(op).unwrap();
     let shift = Arc::new(SymmetricShift::new(op, pencil.clone(), &fr, s).unwrap());
-    let lr = QepLowRankSquared::new(&qep, shift, mu).unwrap();
-    let lu = QepSquaredShift::new(&qep, s).unwrap();
+    let lr = SquaredShift::low_rank(&qep, shift, mu).unwrap();
+    let lu = SquaredShift::lu(&qep, s).unwrap();
     let mut worst = 0.0f64;
     for k in 0..3 {
         let x: Vec<c64> = (0..n)

@@ -17,7 +17,7 @@
 //! stops with `MaxIterations`, whatever the restart cap; there it must say so, and every
 //! mode it does return must still match the reference to 1e-8.
 
-use squeal::core::qep::ComplexModes;
+use squeal::core::operator::ComplexModes;
 use squeal::core::{c64, EigenParams, EigenSolver, Params, StopReason};
 use squeal_io::ParametricOperator;
 use std::path::{Path, PathBuf};

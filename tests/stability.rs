@@ -8,7 +8,7 @@
 //! - an exported operator (both forms) re-imported gives identical eigenvalues.
 
 use squeal::analysis::pipeline::Prepared;
-use squeal::core::qep::ComplexModes;
+use squeal::core::operator::ComplexModes;
 use squeal::core::{c64, EigenParams, FrictionalOperator, Params};
 use squeal::scene::Scene;
 

@@ -3,7 +3,7 @@
 //! * `factor/cholesky_kc/<dofs>`: real sparse Cholesky of `K_c` (symbolic + numeric), the
 //!   factorization of the static responses and of the condensation;
 //! * `factor/lu_squared/<dofs>`: real sparse LU of `K~ - s M~` at `s = (2 pi 5 kHz)^2`
-//!   ([`QepSquaredShift::new`]: sum, symbolic + numeric LU, one probe solve), the
+//!   ([`SquaredShift::lu`]: sum, symbolic + numeric LU, one probe solve), the
 //!   factorization of one window of the full-order band solve when `C = 0`;
 //! * `factor/lu_complex/<dofs>`: complex sparse LU of `Q(sigma) = sigma^2 M~ + K~` at
 //!   `sigma = i 2 pi 5 kHz` on a prebuilt symbolic analysis
@@ -17,7 +17,7 @@ use crate::rig::Rigs;
 use criterion::{BenchmarkId, Criterion, SamplingMode};
 use squeal::core::c64;
 use squeal::core::linalg::Cholesky;
-use squeal::core::qep::{QepShiftInvert, QepSquaredShift, QepSymbolic};
+use squeal::core::spectral::{QepShiftInvert, QepSymbolic, SquaredShift};
 use std::time::{Duration, Instant};
 
 /// Centre of the band (Hz) where the shifts are placed.
@@ -37,7 +37,7 @@ pub fn bench(c: &mut Criterion, rigs: &Rigs) {
     }
     for r in &rigs.rigs {
         group.bench_with_input(BenchmarkId::new("lu_squared", r.dofs()), r, |b, r| {
-            b.iter(|| QepSquaredShift::new(&r.qep, omega * omega).expect("K~ - s M~ factorizes"))
+            b.iter(|| SquaredShift::lu(&r.qep, omega * omega).expect("K~ - s M~ factorizes"))
         });
     }
     for r in rigs.smallest(2) {

@@ -1,6 +1,6 @@
 //! `krylov/arpack_window/<dofs>`: one shift-invert Krylov window of the full-order band
 //! solve: ARPACK `znaupd/zneupd` ([`ArpackComplexKernel`]) for the [`NEV`] eigenvalues of
-//! `OP = (K~ - s M~)^-1 M~` nearest `s = (2 pi 5 kHz)^2` ([`QepSquaredShift`], the path the
+//! `OP = (K~ - s M~)^-1 M~` nearest `s = (2 pi 5 kHz)^2` ([`SquaredShift`], the path the
 //! band driver takes when `C = 0`), tolerance 1e-12.
 //!
 //! The factorization is built once outside the timed loop (it is `factor/lu_squared`): the
@@ -10,7 +10,8 @@
 
 use crate::rig::Rigs;
 use criterion::{BenchmarkId, Criterion, SamplingMode};
-use squeal::core::qep::{ComplexKernel, QepSquaredShift};
+use squeal::core::qep::ComplexKernel;
+use squeal::core::spectral::{SpectralTransform, SquaredShift};
 use squeal_eigen_arpack::ArpackComplexKernel;
 use std::time::{Duration, Instant};
 
@@ -27,11 +28,11 @@ pub fn bench(c: &mut Criterion, rigs: &Rigs) {
     group.measurement_time(Duration::from_secs(3));
     for r in &rigs.rigs {
         // built on first use, so that a filtered-out size costs nothing
-        let mut cell: Option<QepSquaredShift<'_>> = None;
+        let mut cell: Option<SquaredShift<'_>> = None;
         let mut reported = false;
         group.bench_with_input(BenchmarkId::new("arpack_window", r.dofs()), r, |b, _| {
             let op = &*cell.get_or_insert_with(|| {
-                QepSquaredShift::new(&r.qep, omega * omega).expect("K~ - s M~ factorizes")
+                SquaredShift::lu(&r.qep, omega * omega).expect("K~ - s M~ factorizes")
             });
             b.iter(|| {
                 let start = Instant::now();
@@ -42,7 +43,10 @@ pub fn bench(c: &mut Criterion, rigs: &Rigs) {
                     let f: Vec<f64> = out
                         .theta
                         .iter()
-                        .map(|&t| op.lambda_of_theta(t).1.im.abs() / std::f64::consts::TAU)
+                        .map(|&t| {
+                            SquaredShift::lambda_of_s(op.pencil_eigenvalue(t)).im.abs()
+                                / std::f64::consts::TAU
+                        })
                         .collect();
                     let (lo, hi) = f
                         .iter()

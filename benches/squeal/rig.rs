@@ -7,7 +7,7 @@
 
 use crate::models::FILE;
 use squeal::analysis::pipeline::Prepared;
-use squeal::core::qep::Qep;
+use squeal::core::operator::Qep;
 use squeal::core::{FrictionalOperator, Material, Registry};
 use squeal::scene::Scene;
 use std::sync::OnceLock;

@@ -23,7 +23,7 @@ use crate::sweep::{
     TrackOptions,
 };
 use serde::Serialize;
-use squeal_core::qep::ComplexModes;
+use squeal_core::operator::ComplexModes;
 use squeal_core::{EigenParams, FrictionalOperator, Params, Registry, SparseMat, SymmetricProblem};
 use std::time::Instant;
 

@@ -14,8 +14,9 @@
 //! holds at most [`ModalCache::budget_bytes`] of mode shapes and drops the oldest entries
 //! beyond that. Complex (frictional) solves are passed through unchanged.
 
-use squeal_core::eigen::{RealModes, SymmetricProblem};
-use squeal_core::qep::{ComplexModes, Qep};
+use squeal_core::eigen::SymmetricProblem;
+use squeal_core::operator::RealModes;
+use squeal_core::operator::{ComplexModes, Qep};
 use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Result, SparseRef};
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -209,9 +210,9 @@ impl EigenSolver for CachedModal {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use squeal_core::eigen::SolveInfo;
     use squeal_core::faer::sparse::Triplet;
     use squeal_core::faer::Mat;
+    use squeal_core::operator::SolveInfo;
     use squeal_core::SparseMat;
 
     /// Diagonal "solver": the first `nev_hint` diagonal ratios, counting its calls.

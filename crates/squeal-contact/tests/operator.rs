@@ -16,7 +16,8 @@ use squeal_contact::{build_operator, ContactSet};
 use squeal_core::c64;
 use squeal_core::faer::sparse::Triplet;
 use squeal_core::faer::Mat;
-use squeal_core::qep::{dense_qep, Qep};
+use squeal_core::operator::Qep;
+use squeal_core::qep::dense_qep;
 use squeal_core::{FrictionalOperator, Material, SparseMat};
 use squeal_fe::{assemble, DofMap, Mesh};
 

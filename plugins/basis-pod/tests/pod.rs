@@ -15,7 +15,7 @@
 //! A table is printed with `--nocapture`.
 
 use squeal_analysis::pipeline::Prepared;
-use squeal_core::qep::ComplexModes;
+use squeal_core::operator::ComplexModes;
 use squeal_core::reduction::m_orthonormality_error;
 use squeal_core::{
     Basis, BasisRequest, EigenParams, EigenSolver, FrictionalOperator, Params, ReducedOperator,

@@ -11,7 +11,7 @@
 //! Each run prints a table (size, times, errors, backward errors) with `--nocapture`.
 
 use squeal_analysis::pipeline::Prepared;
-use squeal_core::qep::ComplexModes;
+use squeal_core::operator::ComplexModes;
 use squeal_core::{
     BasisRequest, EigenParams, EigenSolver, FrictionalOperator, Params, ReducedOperator, Registry,
 };

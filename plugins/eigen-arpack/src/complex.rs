@@ -6,7 +6,8 @@ use crate::kernel::{request_io, to_int};
 use arpack_ffi::{a_int, znaupd_c, zneupd_c, Complex64, ARPACK_LOCK};
 use squeal_core::c64;
 use squeal_core::faer::Mat;
-use squeal_core::qep::{ComplexKernel, ComplexKernelOutput, ComplexLinOp};
+use squeal_core::qep::{ComplexKernel, ComplexKernelOutput};
+use squeal_core::spectral::LinOp;
 use squeal_core::Result;
 
 // `c64` (`num_complex::Complex<f64>`) and ARPACK's `double _Complex` must share their
@@ -20,8 +21,8 @@ const _: () = {
 /// ARPACK's complex driver (`znaupd`/`zneupd`) in standard mode 1 (`bmat = 'I'`,
 /// `iparam[6] = 1`, `which = "LM"`): the `nev` eigenvalues of largest modulus of a
 /// general complex operator given only by its action `y = OP x` (a
-/// [`ComplexLinOp`], e.g. the companion shift-invert operator
-/// [`QepShiftInvert`](squeal_core::qep::QepShiftInvert), whose `B` is not positive
+/// [`LinOp<c64>`](squeal_core::spectral::LinOp), e.g. the companion shift-invert operator
+/// [`QepShiftInvert`](squeal_core::spectral::QepShiftInvert), whose `B` is not positive
 /// definite, so ARPACK's generalized modes do not apply).
 ///
 /// - Arnoldi basis size `ncv = min(n, max(2 nev + 1, 20))`; ARPACK needs
@@ -53,7 +54,7 @@ impl ArpackComplexKernel {
 impl ComplexKernel for ArpackComplexKernel {
     fn largest(
         &self,
-        op: &dyn ComplexLinOp,
+        op: &dyn LinOp<c64>,
         nev: usize,
         tol: f64,
         max_restarts: usize,
@@ -89,7 +90,7 @@ fn as_arpack(p: *mut c64) -> *mut Complex64 {
 }
 
 fn run(
-    op: &dyn ComplexLinOp,
+    op: &dyn LinOp<c64>,
     nev: usize,
     tol: f64,
     max_restarts: usize,
@@ -165,7 +166,7 @@ impl Session {
 
     /// The `znaupd` reverse-communication loop on `op`, to convergence or the iteration
     /// cap (`info = 1`, not an error). The caller holds `ARPACK_LOCK`.
-    fn iterate(&mut self, op: &dyn ComplexLinOp) -> Result<(), ArpackError> {
+    fn iterate(&mut self, op: &dyn LinOp<c64>) -> Result<(), ArpackError> {
         let n = self.n;
         let mut ido: a_int = 0;
         let mut info: a_int = 1; // use `resid` as the start vector

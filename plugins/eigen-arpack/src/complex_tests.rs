@@ -3,10 +3,14 @@
 
 use super::*;
 use squeal_core::c64;
+use squeal_core::eigen::SymmetricKernel;
 use squeal_core::faer::linalg::solvers::DenseSolveCore;
 use squeal_core::faer::sparse::Triplet;
 use squeal_core::faer::Mat;
-use squeal_core::qep::{dense_qep, ComplexLinOp};
+use squeal_core::qep::dense_qep;
+use squeal_core::qep::ComplexKernel;
+use squeal_core::spectral::{LinOp, SpectralTransform};
+use squeal_core::{EigenParams, EigenSolver, Qep};
 use squeal_core::{Error, SparseMat};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -52,7 +56,7 @@ impl DenseOp {
     }
 }
 
-impl ComplexLinOp for DenseOp {
+impl LinOp<c64> for DenseOp {
     fn dim(&self) -> usize {
         self.a.nrows()
     }
@@ -428,7 +432,7 @@ fn concurrent_complex_and_symmetric_runs_are_serialized() {
     let tm: Vec<_> = (0..n).map(|i| Triplet::new(i, i, 1.0)).collect();
     let k = SparseMat::try_new_from_triplets(n, n, &tk).unwrap();
     let m = SparseMat::try_new_from_triplets(n, n, &tm).unwrap();
-    let si = squeal_core::linalg::ShiftInvert::new(k.as_ref(), m.as_ref(), -1.0).unwrap();
+    let si = squeal_core::spectral::ShiftInvert::new(k.as_ref(), m.as_ref(), -1.0).unwrap();
     std::thread::scope(|sc| {
         let complex: Vec<_> = (0..3)
             .map(|_| sc.spawn(|| ArpackComplexKernel.largest(&op, 10, 1e-12, 300).unwrap()))
@@ -441,7 +445,7 @@ fn concurrent_complex_and_symmetric_runs_are_serialized() {
         }
         let out = sym.join().unwrap();
         assert!(out.all_converged);
-        let mut lam: Vec<f64> = out.theta.iter().map(|&t| si.lambda_of_theta(t)).collect();
+        let mut lam: Vec<f64> = out.theta.iter().map(|&t| si.pencil_eigenvalue(t)).collect();
         lam.sort_by(f64::total_cmp);
         for (i, l) in lam.iter().enumerate() {
             assert!((l - (1.0 + i as f64)).abs() < 1e-10 * l, "{lam:?}");
@@ -534,7 +538,7 @@ fn solve_qep_matches_the_dense_companion_solver() {
         dense_below: 0,
         ..EigenParams::default()
     };
-    let modes = match ArpackSolver.solve_qep(&qep, &params) {
+    let modes = match ARPACK.solve_qep(&qep, &params) {
         Err(Error::Unsupported { .. }) => {
             eprintln!("solve_qep_band not available yet: skipped");
             return;

@@ -4,7 +4,7 @@ use crate::error::{ArpackError, Routine};
 use arpack_ffi::{a_int, dsaupd_c, dseupd_c, ARPACK_LOCK};
 use squeal_core::eigen::{KernelOutput, SymmetricKernel};
 use squeal_core::faer::Mat;
-use squeal_core::linalg::ShiftInvert;
+use squeal_core::spectral::{LinOp, ShiftInvert, SpectralTransform};
 use squeal_core::Result;
 
 /// ARPACK's symmetric driver in shift-invert mode 3 (`bmat = 'G'`, `which = "LM"`) on
@@ -83,7 +83,7 @@ fn run(
     // ARPACK keeps its state in Fortran SAVE variables: one run at a time per process.
     let _guard = ARPACK_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     session.iterate(op)?;
-    session.extract(op.sigma())
+    session.extract(op.shift())
 }
 
 /// The sizes, settings and work arrays of one `dsaupd`/`dseupd` run.

@@ -22,7 +22,7 @@
 //! which is self-adjoint in the `M` inner product `<x, y>_M = x^T M y`; the largest
 //! `theta` are the `lambda` nearest `sigma`, i.e. the lowest modes, and they converge
 //! fast because `theta` decays like `1 / lambda`. The reverse-communication requests of
-//! `dsaupd` map onto the [`ShiftInvert`](squeal_core::linalg::ShiftInvert) operator:
+//! `dsaupd` map onto the [`ShiftInvert`](squeal_core::spectral::ShiftInvert) operator:
 //!
 //! | `ido` | ARPACK asks for | computed as |
 //! |------:|-----------------|-------------|
@@ -45,7 +45,7 @@
 //! Arnoldi iteration `znaupd`/`zneupd` in *standard mode 1* (`bmat = 'I'`,
 //! `which = "LM"`) on the user operator `OP = (A - sigma B)^-1 B` of the companion form
 //! at a complex shift `sigma = i 2 pi f_c`
-//! ([`QepShiftInvert`](squeal_core::qep::QepShiftInvert)). ARPACK's generalized modes
+//! ([`QepShiftInvert`](squeal_core::spectral::QepShiftInvert)). ARPACK's generalized modes
 //! need a Hermitian positive semi-definite `B`, which `B = [I 0; 0 M~]` with a
 //! non-symmetric `M~` is not, hence the standard mode on the shift-inverted operator.
 //! The only reverse-communication request is `ido = -1 / 1`: `y = OP x`. The kernel
@@ -65,66 +65,22 @@ pub use complex::ArpackComplexKernel;
 pub use error::{ArpackError, Routine};
 pub use kernel::ArpackKernel;
 
-use squeal_core::eigen::SymmetricKernel;
-use squeal_core::qep::ComplexKernel;
-use squeal_core::{
-    ComplexModes, EigenParams, EigenSolver, FrictionalOperator, Params, Qep, RealModes, Result,
-    SymmetricProblem,
-};
+use squeal_core::{KernelSolver, Params, Result};
 
 /// The registered name.
 pub const NAME: &str = "arpack";
 
-/// The `arpack` [`EigenSolver`]: the shared band drivers around [`ArpackKernel`]
-/// (normal modes) and [`ArpackComplexKernel`] (complex modes of the QEP).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct ArpackSolver;
+/// The `arpack` [`EigenSolver`](squeal_core::EigenSolver): the shared band drivers around
+/// [`ArpackKernel`] (normal modes) and [`ArpackComplexKernel`] (complex modes of the QEP).
+pub type ArpackSolver = KernelSolver<ArpackKernel, ArpackComplexKernel>;
 
-impl ArpackSolver {
-    /// Builds the solver from plugin parameters; it takes none, so any key is an error.
-    pub fn new(params: &Params) -> Result<Self> {
-        params.tracked().refuse_unread("eigen", NAME)?;
-        Ok(Self)
-    }
+/// The `arpack` solver.
+pub const ARPACK: ArpackSolver = KernelSolver::new(NAME, ArpackKernel, ArpackComplexKernel);
 
-    /// The Krylov kernel used by [`EigenSolver::solve_symmetric`].
-    pub fn kernel(&self) -> &dyn SymmetricKernel {
-        &ArpackKernel
-    }
-
-    /// The Krylov kernel used by [`EigenSolver::solve_qep`].
-    pub fn complex_kernel(&self) -> &dyn ComplexKernel {
-        &ArpackComplexKernel
-    }
-}
-
-impl EigenSolver for ArpackSolver {
-    fn name(&self) -> &str {
-        NAME
-    }
-
-    fn solve_symmetric(
-        &self,
-        problem: &SymmetricProblem<'_>,
-        params: &EigenParams,
-    ) -> Result<RealModes> {
-        squeal_core::solve_symmetric_band(NAME, &ArpackKernel, problem, params)
-    }
-
-    fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {
-        squeal_core::qep::solve_qep_band(NAME, &ArpackComplexKernel, qep, params)
-    }
-
-    /// The frictional operator through [`squeal_core::qep::solve_frictional_band`]: an
-    /// undamped operator may take the low-rank (symmetric factorization + Woodbury) path.
-    fn solve_frictional(
-        &self,
-        op: &FrictionalOperator,
-        mu: f64,
-        params: &EigenParams,
-    ) -> Result<ComplexModes> {
-        squeal_core::qep::solve_frictional_band(NAME, &ArpackComplexKernel, op, mu, params)
-    }
+/// Builds the solver from plugin parameters; it takes none, so any key is an error.
+pub fn solver(params: &Params) -> Result<ArpackSolver> {
+    params.tracked().refuse_unread("eigen", NAME)?;
+    Ok(ARPACK)
 }
 
 /// Registers the `arpack` eigen solver.
@@ -133,7 +89,7 @@ pub fn register(reg: &mut squeal_core::Registry) {
         NAME,
         "ARPACK shift-invert Lanczos (dsaupd mode 3) on a sparse Cholesky of K - sigma M; \
          complex modes by znaupd (mode 1) on the companion shift-invert operator (sparse LU)",
-        |p| Ok(Box::new(ArpackSolver::new(p)?)),
+        |p| Ok(Box::new(solver(p)?)),
     );
 }
 

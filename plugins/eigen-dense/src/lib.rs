@@ -20,7 +20,8 @@
 //!   sparse backends.
 
 use squeal_core::eigen::{dense_symmetric, finish_real_modes, validate_params};
-use squeal_core::qep::{check_qep, dense_qep, finish_modes};
+use squeal_core::operator::check_qep;
+use squeal_core::qep::{dense_qep, finish_modes};
 use squeal_core::{
     ComplexModes, EigenParams, EigenSolver, Error, Params, Qep, RealModes, Registry, Result,
     SolveInfo, SymmetricProblem,

@@ -7,7 +7,8 @@ use super::{
 use squeal_core::eigen::KernelOutput;
 use squeal_core::faer::linalg::matmul::matmul;
 use squeal_core::faer::{Accum, Mat, MatMut, MatRef, Side};
-use squeal_core::linalg::{dot, ShiftInvert};
+use squeal_core::linalg::dot;
+use squeal_core::spectral::{LinOp, ShiftInvert};
 use squeal_core::{Error, Result};
 
 /// [`super::LanczosKernel::largest`] from a given start vector.

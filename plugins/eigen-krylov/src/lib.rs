@@ -114,11 +114,8 @@
 
 use squeal_core::eigen::{KernelOutput, SymmetricKernel};
 use squeal_core::faer::{self, Par};
-use squeal_core::linalg::ShiftInvert;
-use squeal_core::{
-    ComplexModes, EigenParams, EigenSolver, Error, FrictionalOperator, Params, Qep, RealModes,
-    Registry, Result, SymmetricProblem,
-};
+use squeal_core::spectral::{LinOp, ShiftInvert};
+use squeal_core::{EigenSolver, Error, KernelSolver, Params, Registry, Result};
 
 mod lanczos;
 mod pairs;
@@ -156,47 +153,19 @@ const PAR_THRESHOLD: usize = 1 << 16;
 
 /// Registers the `"krylov"` eigen solver.
 pub fn register(reg: &mut Registry) {
-    reg.eigen.register(NAME, DESCRIPTION, |_: &Params| {
-        let solver: Box<dyn EigenSolver> = Box::new(KrylovSolver);
+    reg.eigen.register(NAME, DESCRIPTION, |p: &Params| {
+        p.tracked().refuse_unread("eigen", NAME)?;
+        let solver: Box<dyn EigenSolver> = Box::new(KRYLOV);
         Ok(solver)
     });
 }
 
-/// The `"krylov"` eigen solver: the shared band driver
-/// [`squeal_core::solve_symmetric_band`] around [`LanczosKernel`].
-#[derive(Debug, Clone, Copy, Default)]
-pub struct KrylovSolver;
+/// The `"krylov"` eigen solver: the shared band drivers around [`LanczosKernel`] (normal
+/// modes) and [`KrylovSchurKernel`] (complex modes of the QEP).
+pub type KrylovSolver = KernelSolver<LanczosKernel, KrylovSchurKernel>;
 
-impl EigenSolver for KrylovSolver {
-    fn name(&self) -> &str {
-        NAME
-    }
-
-    fn solve_symmetric(
-        &self,
-        problem: &SymmetricProblem<'_>,
-        params: &EigenParams,
-    ) -> Result<RealModes> {
-        squeal_core::solve_symmetric_band(NAME, &LanczosKernel, problem, params)
-    }
-
-    /// The frictional QEP: the shared complex band driver
-    /// [`squeal_core::qep::solve_qep_band`] around [`KrylovSchurKernel`].
-    fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {
-        squeal_core::qep::solve_qep_band(NAME, &KrylovSchurKernel, qep, params)
-    }
-
-    /// The frictional operator through [`squeal_core::qep::solve_frictional_band`]: an
-    /// undamped operator may take the low-rank (symmetric factorization + Woodbury) path.
-    fn solve_frictional(
-        &self,
-        op: &FrictionalOperator,
-        mu: f64,
-        params: &EigenParams,
-    ) -> Result<ComplexModes> {
-        squeal_core::qep::solve_frictional_band(NAME, &KrylovSchurKernel, op, mu, params)
-    }
-}
+/// The `"krylov"` solver.
+pub const KRYLOV: KrylovSolver = KernelSolver::new(NAME, LanczosKernel, KrylovSchurKernel);
 
 /// Thick-restart Lanczos for the largest eigenvalues of `OP = (K - sigma M)^-1 M` in
 /// the `M` inner product, with full reorthogonalization, locking and validation runs

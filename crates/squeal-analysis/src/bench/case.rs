@@ -6,7 +6,7 @@ use crate::jsonl::{nan, null_as_nan};
 use crate::pipeline::{PipelineError, Result};
 use serde::{Deserialize, Serialize};
 use squeal_core::contact::BasisRequest;
-use squeal_core::qep::ComplexModes;
+use squeal_core::operator::ComplexModes;
 use squeal_core::reduction::ReducedOperator;
 use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Params, Registry};
 use std::time::Instant;

@@ -3,7 +3,7 @@
 
 use crate::jsonl::{nan, null_as_nan};
 use serde::{Deserialize, Serialize};
-use squeal_core::qep::ComplexModes;
+use squeal_core::operator::ComplexModes;
 
 /// When a run counts as accurate: every reference mode in the band found, no missed or
 /// false unstable mode, and the errors below these bounds.

@@ -142,7 +142,7 @@ pub struct MuSweep {
     pub free: FreeModes,
     /// The complex modes at [`MuSweepSettings::keep_modes_at`] computed in this run (a
     /// point read back from a checkpoint keeps none).
-    pub kept: Vec<(f64, squeal_core::qep::ComplexModes)>,
+    pub kept: Vec<(f64, squeal_core::operator::ComplexModes)>,
     /// Wall time (s).
     pub time_s: f64,
     /// Where it went: the free model's modes and synthesis, then the stages of the points

@@ -15,7 +15,7 @@ use squeal_contact::{
 };
 use squeal_core::contact::{Condensation, NormalModes};
 use squeal_core::linalg::Cholesky;
-use squeal_core::qep::ComplexModes;
+use squeal_core::operator::ComplexModes;
 use squeal_core::{
     EigenParams, EigenSolver, FreeModel, FrictionalOperator, ModelStage, PairDofs, Params,
     RealModes, ReductionBasis, Registry, SymmetricProblem,

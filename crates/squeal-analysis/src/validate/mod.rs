@@ -392,7 +392,7 @@ fn references(
     prep: &Prepared,
     s: &ValidateSettings,
     band: [f64; 2],
-    kept: &[(String, Vec<(f64, squeal_core::qep::ComplexModes)>)],
+    kept: &[(String, Vec<(f64, squeal_core::operator::ComplexModes)>)],
 ) -> Result<Vec<RefRow>, RunError> {
     let params = EigenParams {
         fmin_hz: band[0],

@@ -1,8 +1,9 @@
 //! The [`ReductionBasis`] plugin trait and the data it exchanges: the request
 //! ([`BasisRequest`]) and the basis it builds ([`Basis`]).
 
-use super::{FreeModel, FrictionalOperator, ModelStage};
+use super::{FreeModel, ModelStage};
 use crate::eigen::{EigenParams, EigenSolver};
+use crate::operator::FrictionalOperator;
 use crate::{Error, Result};
 use faer::Mat;
 use std::any::Any;

@@ -12,7 +12,6 @@ mod condensation;
 mod equilibrium;
 mod law;
 mod lcp;
-mod operator;
 mod stage;
 
 pub use basis::{build_basis, Basis, BasisRequest, ReductionBasis};
@@ -20,5 +19,4 @@ pub use condensation::{add_transpose_times, Condensation};
 pub use equilibrium::{check_mu, ContactProblem, Equilibrium, EquilibriumSolver};
 pub use law::ContactLaw;
 pub use lcp::{solve_lcp, LcpSolution};
-pub use operator::FrictionalOperator;
 pub use stage::{FreeModel, ModelStage, NormalModes, PairDofs};

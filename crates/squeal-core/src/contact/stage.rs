@@ -10,8 +10,9 @@
 //! hands it back in every [`BasisRequest::stage`](super::BasisRequest::stage). The stage's
 //! type belongs to its plugin: the caller only stores it.
 
-use crate::eigen::{EigenParams, EigenSolver, RealModes};
+use crate::eigen::{EigenParams, EigenSolver};
 use crate::linalg::Cholesky;
+use crate::operator::RealModes;
 use crate::{Result, SparseRef};
 use std::any::Any;
 use std::sync::Arc;

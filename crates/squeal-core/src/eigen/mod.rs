@@ -2,7 +2,7 @@
 //!
 //! Normal modes solve `K x = omega^2 M x` with `K` symmetric positive semi-definite and
 //! `M` symmetric positive definite, on the free DOFs. Every backend works on the same
-//! [`ShiftInvert`](crate::linalg::ShiftInvert) operator `(K - sigma M)^-1 M` (shift below the spectrum, one Cholesky
+//! [`ShiftInvert`](crate::spectral::ShiftInvert) transformation `(K - sigma M)^-1 M` (shift below the spectrum, one Cholesky
 //! factorization) through the [`SymmetricKernel`] trait; the band logic, the
 //! back-transformation, the normalization and the residuals are written once, in
 //! [`solve_symmetric_band`], so backends differ only in their Krylov iteration.
@@ -14,9 +14,9 @@ mod params;
 mod solver;
 mod symmetric;
 
-pub use params::{too_many_modes, validate_params, EigenParams, SolveInfo, StopReason};
+pub use params::{too_many_modes, validate_params, EigenParams};
 pub use solver::EigenSolver;
 pub use symmetric::{
-    dense_symmetric, finish_real_modes, solve_symmetric_band, KernelOutput, RealModes,
-    SymmetricKernel, SymmetricProblem,
+    dense_symmetric, finish_real_modes, solve_symmetric_band, KernelOutput, SymmetricKernel,
+    SymmetricProblem,
 };

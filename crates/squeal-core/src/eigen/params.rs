@@ -1,5 +1,4 @@
-//! What a solve is asked ([`EigenParams`], checked by [`validate_params`]) and what it
-//! reports ([`SolveInfo`], [`StopReason`]).
+//! What a solve is asked ([`EigenParams`], checked by [`validate_params`]).
 
 use crate::{Error, Result};
 
@@ -36,56 +35,6 @@ impl Default for EigenParams {
             nev_hint: None,
             dense_below: 120,
             max_modes: 3000,
-        }
-    }
-}
-
-/// Why a solve stopped.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum StopReason {
-    /// All requested pairs met the tolerance.
-    Converged,
-    /// The iteration cap was hit; `converged` in [`SolveInfo`] says how many made it.
-    MaxIterations,
-}
-
-/// Cost and convergence report attached to every solve.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SolveInfo {
-    /// Backend name.
-    pub solver: String,
-    /// Wall time (s), factorizations included.
-    pub time_s: f64,
-    /// Pairs requested in the last Krylov run.
-    pub requested: usize,
-    /// Pairs converged in the last Krylov run.
-    pub converged: usize,
-    /// Restarts / update iterations, summed over runs.
-    pub iterations: usize,
-    /// Operator applications (one sparse solve each).
-    pub op_applications: usize,
-    /// Sparse factorizations performed.
-    pub factorizations: usize,
-    /// Why it stopped.
-    pub reason: StopReason,
-    /// Anything the user should know (fallbacks, enlarged requests).
-    pub notes: Vec<String>,
-}
-
-impl SolveInfo {
-    /// A report of `solver` with every count zero, stopped on convergence, no notes: the
-    /// start of every backend's report.
-    pub fn new(solver: impl Into<String>) -> Self {
-        Self {
-            solver: solver.into(),
-            time_s: 0.0,
-            requested: 0,
-            converged: 0,
-            iterations: 0,
-            op_applications: 0,
-            factorizations: 0,
-            reason: StopReason::Converged,
-            notes: Vec::new(),
         }
     }
 }

@@ -1,8 +1,7 @@
 //! The [`EigenSolver`] plugin trait.
 
-use super::{EigenParams, RealModes, SymmetricProblem};
-use crate::contact::FrictionalOperator;
-use crate::qep::{ComplexModes, Qep};
+use super::{EigenParams, SymmetricProblem};
+use crate::operator::{ComplexModes, FrictionalOperator, Qep, RealModes};
 use crate::{Error, Result};
 
 /// The eigen solver plugin trait: real normal modes of a symmetric pencil and complex

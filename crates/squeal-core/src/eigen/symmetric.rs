@@ -2,8 +2,10 @@
 //! every symmetric backend shares ([`solve_symmetric_band`], [`finish_real_modes`]) and
 //! the dense solver ([`dense_symmetric`]).
 
-use super::{too_many_modes, validate_params, EigenParams, SolveInfo, StopReason};
-use crate::linalg::{norm1, norm2, spmv, ShiftInvert};
+use super::{too_many_modes, validate_params, EigenParams};
+use crate::linalg::{norm1, norm2, spmv};
+use crate::operator::{RealModes, SolveInfo, StopReason};
+use crate::spectral::{ShiftInvert, SpectralTransform};
 use crate::{Error, Result, SparseRef};
 use faer::Mat;
 use std::time::Instant;
@@ -15,21 +17,6 @@ pub struct SymmetricProblem<'a> {
     pub k: SparseRef<'a>,
     /// Mass (kg), symmetric positive definite.
     pub m: SparseRef<'a>,
-}
-
-/// Real normal modes in a band, sorted by frequency.
-#[derive(Debug, Clone)]
-pub struct RealModes {
-    /// Eigenvalues `omega^2`, (rad/s)^2.
-    pub omega2: Vec<f64>,
-    /// Frequencies (Hz); negative round-off eigenvalues give 0.
-    pub freq_hz: Vec<f64>,
-    /// Mode shapes on the free DOFs, one column per mode, `M`-orthonormal.
-    pub vectors: Mat<f64>,
-    /// Relative residual of each pair (see module docs).
-    pub residuals: Vec<f64>,
-    /// How the solve went.
-    pub info: SolveInfo,
 }
 
 /// Output of a [`SymmetricKernel`]: the largest eigenvalues of the shift-invert operator.
@@ -99,7 +86,7 @@ pub fn solve_symmetric_band(
             if !out.all_converged {
                 info.reason = StopReason::MaxIterations;
             }
-            let lam: Vec<f64> = out.theta.iter().map(|&t| op.lambda_of_theta(t)).collect();
+            let lam: Vec<f64> = out.theta.iter().map(|&t| op.pencil_eigenvalue(t)).collect();
             let reached = lam.iter().any(|&l| l > top);
             if reached || nev >= n - 1 || !out.all_converged {
                 if !reached && nev < n - 1 {

@@ -1,8 +1,8 @@
 //! The friction part as an explicit low-rank product `F_K = U W_K^T`, `F_M = U W_M^T`
 //! ([`FrictionLowRank`]).
 
-use crate::contact::FrictionalOperator;
 use crate::linalg::norm1;
+use crate::operator::FrictionalOperator;
 use crate::{Error, Result, SparseMat, SparseRef};
 use faer::sparse::Triplet;
 

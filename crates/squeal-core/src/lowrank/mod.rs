@@ -8,7 +8,7 @@
 //! ```
 //!
 //! where `S(s)` is real symmetric (indefinite for `s` inside the spectrum) and
-//! `U = T^T P~t^T` ([`FrictionalOperator::friction_loads`](crate::contact::FrictionalOperator::friction_loads), `n x nA`) has one column per
+//! `U = T^T P~t^T` ([`FrictionalOperator::friction_loads`](crate::operator::FrictionalOperator::friction_loads), `n x nA`) has one column per
 //! active pair. Every column of `U` is supported on DOFs of its own pair only, so the row
 //! `r` of the largest `|U_ri|` gives `w_i^T = F_X[r, :] / U[r, i]` ([`FrictionLowRank`]).
 //!
@@ -20,7 +20,7 @@
 //! A^-1 b = S^-1 b + mu Z G^-1 W^T S^-1 b
 //! ```
 //!
-//! ([`QepLowRankSquared`]): one symmetric solve and two thin dense products per
+//! ([`Woodbury`]): one symmetric solve and two thin dense products per
 //! application. `S(s)`, its factorization, `W(s)` and `Z` depend on `s` only, not on
 //! `mu`: a [`SymmetricShift`] is `Arc`-shareable across friction coefficients.
 //!
@@ -34,4 +34,4 @@ mod woodbury;
 pub use friction::{FrictionLowRank, MAX_IDENTITY_ERROR};
 pub use pencil::{SymmetricPencil, MAX_ASYMMETRY};
 pub use shift::SymmetricShift;
-pub use woodbury::{QepLowRankSquared, REFINE_ABOVE};
+pub use woodbury::{Woodbury, REFINE_ABOVE};

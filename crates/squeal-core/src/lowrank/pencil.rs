@@ -1,7 +1,7 @@
 //! The symbolic analysis of the symmetric pencil `S(s) = K_c - s M_c`, shared by every
 //! shift ([`SymmetricPencil`]).
 
-use crate::contact::FrictionalOperator;
+use crate::operator::FrictionalOperator;
 use crate::ordering::{symmetric_ordering, FillOrdering};
 use crate::{Error, Result, SparseMat, SparseRef};
 use faer::sparse::linalg::cholesky::{

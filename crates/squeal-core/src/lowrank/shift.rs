@@ -2,8 +2,8 @@
 //! `L B L^T` of `S(s) = K_c - s M_c`, `W(s)` and `Z = S(s)^-1 U`.
 
 use super::{FrictionLowRank, SymmetricPencil};
-use crate::contact::FrictionalOperator;
 use crate::linalg::norm1;
+use crate::operator::FrictionalOperator;
 use crate::{Error, Result, SparseMat};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;

@@ -1,38 +1,34 @@
-//! The Woodbury shift-invert of an undamped frictional QEP ([`QepLowRankSquared`]):
+//! The Woodbury solve of an undamped frictional QEP's shifted matrix ([`Woodbury`]):
 //! `A(s)^-1 b = S^-1 b + mu Z G^-1 W^T S^-1 b` on a [`SymmetricShift`].
 
 use super::SymmetricShift;
 use crate::linalg::norm1;
-use crate::qep::vector::spmv_complex_split;
-use crate::qep::{ComplexLinOp, Qep};
-use crate::{c64, Error, Result};
+use crate::operator::Qep;
+use crate::{Error, Result};
 use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::{PartialPivLu, Solve};
 use faer::{Accum, Mat, MatMut};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
-/// Relative residual of a probe solve above which [`QepLowRankSquared`] adds one step of
+/// Relative residual of a probe solve above which [`Woodbury`] adds one step of
 /// iterative refinement to every application.
 pub const REFINE_ABOVE: f64 = 1e-11;
 
-/// Shift-invert of the squared transformation of an undamped frictional QEP through the
-/// low-rank structure: `OP = A(s)^-1 M~` with `A(s) = K~ - s M~` applied by the Woodbury
-/// identity on a [`SymmetricShift`] (see the module docs). Same contract as
-/// [`QepSquaredShift`](crate::qep::QepSquaredShift): `s = sigma_s + 1/theta`,
-/// `lambda = i sqrt(s)`.
-pub struct QepLowRankSquared<'a> {
+/// Solves with `A(s) = K~ - s M~` of an undamped frictional QEP through its low-rank
+/// structure: the Woodbury identity on a [`SymmetricShift`] (see the module docs). The
+/// squared transformation ([`SquaredShift::low_rank`](crate::spectral::SquaredShift::low_rank))
+/// applies it.
+pub struct Woodbury<'a> {
     qep: &'a Qep,
     shift: Arc<SymmetricShift>,
     mu: f64,
     g: PartialPivLu<f64>,
     refine: bool,
     residual: f64,
-    applications: AtomicUsize,
 }
 
-impl<'a> QepLowRankSquared<'a> {
-    /// Builds the operator for `qep = op.at(mu)` (undamped) on a factorized shift: forms
+impl<'a> Woodbury<'a> {
+    /// Builds the solver for `qep = op.at(mu)` (undamped) on a factorized shift: forms
     /// and factorizes `G = I - mu W^T Z`, then checks one solve with `A(s)`; when its
     /// relative residual exceeds [`REFINE_ABOVE`], every application adds one step of
     /// iterative refinement.
@@ -45,7 +41,7 @@ impl<'a> QepLowRankSquared<'a> {
         }
         if shift.dim() != n {
             return Err(Error::Dimension {
-                context: "QepLowRankSquared: shift factorization of another size".into(),
+                context: "Woodbury: shift factorization of another size".into(),
                 expected: n,
                 got: shift.dim(),
             });
@@ -88,7 +84,6 @@ impl<'a> QepLowRankSquared<'a> {
             g,
             refine: false,
             residual: 0.0,
-            applications: AtomicUsize::new(0),
         };
         let b = Mat::<f64>::from_fn(n, 1, |i, _| 1.0 + 0.1 * (i as f64).sin());
         let mut x = b.clone();
@@ -123,17 +118,6 @@ impl<'a> QepLowRankSquared<'a> {
     /// Whether applications add a step of iterative refinement.
     pub fn refines(&self) -> bool {
         self.refine
-    }
-
-    /// How many times the operator was applied.
-    pub fn applications(&self) -> usize {
-        self.applications.load(Ordering::Relaxed)
-    }
-
-    /// `s = sigma_s + 1/theta` and `lambda = i sqrt(s)`.
-    pub fn lambda_of_theta(&self, theta: c64) -> (c64, c64) {
-        let s = c64::new(self.shift.s, 0.0) + c64::new(1.0, 0.0) / theta;
-        (s, c64::new(0.0, 1.0) * s.sqrt())
     }
 
     /// `B <- A(s)^-1 B` by Woodbury (plus refinement when [`refines`](Self::refines)).
@@ -199,31 +183,5 @@ impl<'a> QepLowRankSquared<'a> {
         } else {
             0.0
         }
-    }
-}
-
-impl ComplexLinOp for QepLowRankSquared<'_> {
-    fn dim(&self) -> usize {
-        self.qep.dim()
-    }
-
-    fn apply(&self, x: &[c64], y: &mut [c64]) {
-        let n = self.qep.dim();
-        assert_eq!(
-            x.len(),
-            n,
-            "QepLowRankSquared::apply: x has the wrong length"
-        );
-        assert_eq!(
-            y.len(),
-            n,
-            "QepLowRankSquared::apply: y has the wrong length"
-        );
-        let mut b = spmv_complex_split(self.qep.m.as_ref(), x);
-        self.solve_in_place(b.as_mut());
-        for (i, v) in y.iter_mut().enumerate() {
-            *v = c64::new(b[(i, 0)], b[(i, 1)]);
-        }
-        self.applications.fetch_add(1, Ordering::Relaxed);
     }
 }

@@ -4,13 +4,12 @@
 
 use super::residual::QepNorms;
 use super::window::BandRun;
-use super::{
-    check_qep, dense_qep, finish_modes_with, ComplexKernel, ComplexModes, Condition, Qep,
-    QepSymbolic,
-};
-use crate::contact::FrictionalOperator;
-use crate::eigen::{validate_params, EigenParams, SolveInfo};
+use super::{dense_qep, finish_modes_with, ComplexKernel, Condition};
+use crate::eigen::{validate_params, EigenParams};
 use crate::lowrank::{FrictionLowRank, SymmetricPencil};
+use crate::operator::SolveInfo;
+use crate::operator::{check_qep, ComplexModes, FrictionalOperator, Qep};
+use crate::spectral::QepSymbolic;
 use crate::{c64, Error, Result};
 use faer::Mat;
 use std::sync::Arc;
@@ -31,10 +30,10 @@ pub struct QepBandOptions {
     pub max_depth: usize,
     /// First `nev` when [`EigenParams::nev_hint`] is `None`.
     pub nev_default: usize,
-    /// Use the real squared transformation ([`QepSquaredShift`](super::QepSquaredShift)) when `C = 0`.
+    /// Use the real squared transformation ([`SquaredShift`](crate::spectral::SquaredShift)) when `C = 0`.
     pub squared_when_undamped: bool,
     /// Whether the squared transformation of an undamped frictional operator goes through
-    /// the low-rank (Woodbury) path ([`QepLowRankSquared`](crate::lowrank::QepLowRankSquared)) instead of a sparse LU of
+    /// the low-rank (Woodbury) path ([`SquaredShift::low_rank`](crate::spectral::SquaredShift::low_rank)) instead of a sparse LU of
     /// `K~ - s M~`. Only [`solve_frictional_band_with`] can use it (it needs the parts of
     /// the operator); [`solve_qep_band_with`] ignores it.
     pub low_rank: LowRank,
@@ -77,7 +76,7 @@ impl Default for QepBandOptions {
 }
 
 /// Band driver shared by the full-order complex backends: shifts `i 2 pi f` chosen to cover
-/// `[params.fmin_hz, params.fmax_hz]`, the kernel run on [`QepShiftInvert`](super::QepShiftInvert) for each, `nev`
+/// `[params.fmin_hz, params.fmax_hz]`, the kernel run on [`QepShiftInvert`](crate::spectral::QepShiftInvert) for each, `nev`
 /// grown until every window is covered, eigenvalues mapped back, duplicates merged, and the
 /// result finished by [`finish_modes`](super::finish_modes).
 ///

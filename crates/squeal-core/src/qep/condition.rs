@@ -35,8 +35,10 @@
 //!   when the basis does not contain the full left eigenvector the estimate can be off
 //!   (the missing part of `y` is where the true first-order error lives).
 
+use super::dense_qep;
 use super::residual::QepTerms;
-use super::{check_qep, dense_qep, Qep, QepShiftInvert, QepSymbolic};
+use crate::operator::{check_qep, Qep};
+use crate::spectral::{QepShiftInvert, QepSymbolic};
 use crate::{c64, Error, Result, SparseRef};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef};

@@ -1,8 +1,8 @@
 //! The dense solver of small and reduced QEPs ([`dense_qep`]): the scaled companion
 //! form, or the `n x n` problem of an undamped one.
 
-use super::{check_qep, Qep};
 use crate::linalg::norm1;
+use crate::operator::{check_qep, Qep};
 use crate::{c64, Error, Result};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, MatRef};

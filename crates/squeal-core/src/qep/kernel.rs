@@ -1,17 +1,9 @@
-//! The traits of the full-order complex backends: a complex linear operator
-//! ([`ComplexLinOp`]) and a Krylov iteration for its eigenvalues of largest modulus
-//! ([`ComplexKernel`]).
+//! The trait of the full-order complex backends: a Krylov iteration for the eigenvalues
+//! of largest modulus of a complex operator ([`ComplexKernel`]).
 
+use crate::spectral::LinOp;
 use crate::{c64, Result};
 use faer::Mat;
-
-/// A complex linear operator `y = OP x` (a shift-invert operator, a test matrix...).
-pub trait ComplexLinOp: Sync {
-    /// Size of the operator.
-    fn dim(&self) -> usize;
-    /// `y = OP x`; `x` and `y` have length [`dim`](Self::dim).
-    fn apply(&self, x: &[c64], y: &mut [c64]);
-}
 
 /// Output of a [`ComplexKernel`]: eigenpairs of largest modulus of the operator.
 #[derive(Debug, Clone)]
@@ -32,7 +24,7 @@ pub trait ComplexKernel: Send + Sync {
     /// Computes the `nev` eigenpairs of largest `|theta|` to relative tolerance `tol`.
     fn largest(
         &self,
-        op: &dyn ComplexLinOp,
+        op: &dyn LinOp<c64>,
         nev: usize,
         tol: f64,
         max_restarts: usize,

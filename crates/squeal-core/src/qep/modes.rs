@@ -5,58 +5,13 @@
 
 use super::condition::{self, LeftSource};
 use super::residual::{backward_errors, QepTerms};
-use super::vector::norm2_c;
-use super::{left_eigenvectors, Condition, Qep};
-use crate::contact::FrictionalOperator;
-use crate::eigen::{EigenParams, SolveInfo};
+use super::{left_eigenvectors, Condition};
+use crate::eigen::EigenParams;
+use crate::linalg::norm2_c;
+use crate::operator::{ComplexModes, FrictionalOperator, Qep, SolveInfo};
 use crate::{c64, Error, Result};
 use faer::Mat;
 use std::time::Instant;
-
-/// Complex modes of a QEP in a frequency band, sorted by frequency.
-#[derive(Debug, Clone)]
-pub struct ComplexModes {
-    /// Eigenvalues `lambda` (1/s), the `Im > 0` member of each pair.
-    pub lambda: Vec<c64>,
-    /// Matching mode shapes on the operator's DOFs, one column per mode, unit 2-norm.
-    pub vectors: Mat<c64>,
-    /// Frequencies `Im(lambda) / 2 pi` (Hz).
-    pub freq_hz: Vec<f64>,
-    /// Divergence rates `Re(lambda) / Im(lambda)`.
-    pub dvr: Vec<f64>,
-    /// Backward error of each pair on the operator (see module docs).
-    pub backward_error: Vec<f64>,
-    /// Condition number of each eigenvalue,
-    /// `||y|| ||x|| (|lambda|^2 ||M|| + |lambda| ||C|| + ||K||) / (|lambda| |y^H Q'(lambda) x|)`
-    /// with the left eigenvector `y`; NaN where no left vector was computed (see
-    /// [`Condition`] and the [`condition`] module for what it promises and where it fails).
-    pub cond: Vec<f64>,
-    /// First-order estimate of the relative forward error of each eigenvalue,
-    /// `|lambda - lambda_exact| / |lambda| <~ cond * backward_error`; NaN where `cond` is.
-    pub error_bound: Vec<f64>,
-    /// The left eigenvectors behind `cond` (`y^H Q(lambda) = 0`), one column per mode,
-    /// unit 2-norm except inside a cluster of (nearly) equal eigenvalues, where they are
-    /// bi-orthogonalized against the right vectors; `None` when not computed.
-    pub left_vectors: Option<Mat<c64>>,
-    /// How the solve went.
-    pub info: SolveInfo,
-}
-
-impl ComplexModes {
-    /// Number of modes.
-    pub fn len(&self) -> usize {
-        self.lambda.len()
-    }
-    /// Whether no mode was found.
-    pub fn is_empty(&self) -> bool {
-        self.lambda.is_empty()
-    }
-    /// Whether mode `i` is unstable: its divergence rate `DvR = Re / Im` exceeds
-    /// `dvr_tol` (the one threshold of every command, `--dvr-tol`).
-    pub fn is_unstable(&self, i: usize, dvr_tol: f64) -> bool {
-        self.dvr[i] > dvr_tol
-    }
-}
 
 /// Relative size of `Im(lambda)` below which a root counts as real (not an oscillating
 /// mode): `|Im(lambda)| <= REAL_ROOT_REL |lambda|`. Such roots are dropped by

@@ -2,10 +2,9 @@
 //! pair ([`backward_error`]) or a batch at once, on an assembled problem or on the parts
 //! `X_c - mu F_X` of a frictional operator without assembling it.
 
-use super::vector::{norm2_c, spmv_complex, spmv_complex_add};
-use super::Qep;
-use crate::contact::FrictionalOperator;
 use crate::linalg::norm1;
+use crate::linalg::{norm2_c, spmv_complex, spmv_complex_add};
+use crate::operator::{FrictionalOperator, Qep};
 use crate::{c64, SparseMat, SparseRef};
 use faer::MatRef;
 

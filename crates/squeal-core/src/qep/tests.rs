@@ -1,8 +1,9 @@
 use super::residual::{backward_errors, QepNorms, QepTerms};
 use super::*;
-use crate::contact::FrictionalOperator;
-use crate::eigen::{EigenParams, SolveInfo, StopReason};
-use crate::{c64, Error};
+use crate::eigen::EigenParams;
+use crate::operator::{ComplexModes, FrictionalOperator, Qep, SolveInfo, StopReason};
+use crate::spectral::{LinOp, QepShiftInvert, QepSymbolic, SpectralTransform};
+use crate::{c64, Error, Result, SparseMat};
 use faer::linalg::solvers::Solve;
 use faer::sparse::Triplet;
 use faer::Mat;
@@ -115,7 +116,7 @@ fn companion(qep: &Qep) -> (Mat<c64>, Mat<c64>) {
     (a, b)
 }
 
-fn materialize(op: &dyn ComplexLinOp) -> Mat<c64> {
+fn materialize(op: &dyn LinOp<c64>) -> Mat<c64> {
     let nn = op.dim();
     let mut out = Mat::<c64>::zeros(nn, nn);
     let mut e = vec![c(0.0, 0.0); nn];
@@ -221,7 +222,7 @@ struct PanicKernel;
 impl ComplexKernel for PanicKernel {
     fn largest(
         &self,
-        _: &dyn ComplexLinOp,
+        _: &dyn LinOp<c64>,
         _: usize,
         _: f64,
         _: usize,
@@ -430,7 +431,7 @@ struct DenseOpKernel;
 impl ComplexKernel for DenseOpKernel {
     fn largest(
         &self,
-        op: &dyn ComplexLinOp,
+        op: &dyn LinOp<c64>,
         nev: usize,
         _tol: f64,
         _max_restarts: usize,

@@ -3,44 +3,30 @@
 
 use super::band::{LowRankCtx, QepBandOptions};
 use super::residual::{backward_error_with, QepNorms};
-use super::{ComplexKernel, ComplexLinOp, Qep, QepShiftInvert, QepSquaredShift, QepSymbolic};
-use crate::eigen::{EigenParams, SolveInfo, StopReason};
-use crate::lowrank::{QepLowRankSquared, SymmetricShift};
+use super::ComplexKernel;
+use crate::eigen::EigenParams;
+use crate::lowrank::SymmetricShift;
+use crate::operator::{Qep, SolveInfo, StopReason};
+use crate::spectral::{QepShiftInvert, QepSymbolic, SpectralTransform, SquaredShift};
 use crate::{c64, Error, Result};
 use std::sync::Arc;
 use std::time::Instant;
 
-/// The operator of one window of the band driver.
-enum WindowOp<'a> {
-    Companion(QepShiftInvert<'a>),
-    Squared(QepSquaredShift<'a>),
-    LowRank(QepLowRankSquared<'a>),
+/// The spectral transformation of one window of the band driver (companion or squared)
+/// and whether it is the squared one (its points are `s = -lambda^2`).
+struct WindowOp<'a> {
+    op: Box<dyn SpectralTransform<c64> + 'a>,
+    squared: bool,
 }
 
 impl WindowOp<'_> {
-    fn linop(&self) -> &dyn ComplexLinOp {
-        match self {
-            WindowOp::Companion(o) => o,
-            WindowOp::Squared(o) => o,
-            WindowOp::LowRank(o) => o,
-        }
-    }
     /// (point in the plane of the window, lambda).
     fn map(&self, theta: c64) -> (c64, c64) {
-        match self {
-            WindowOp::Companion(o) => {
-                let l = o.lambda_of_theta(theta);
-                (l, l)
-            }
-            WindowOp::Squared(o) => o.lambda_of_theta(theta),
-            WindowOp::LowRank(o) => o.lambda_of_theta(theta),
-        }
-    }
-    fn applications(&self) -> usize {
-        match self {
-            WindowOp::Companion(o) => o.applications(),
-            WindowOp::Squared(o) => o.applications(),
-            WindowOp::LowRank(o) => o.applications(),
+        let point = self.op.pencil_eigenvalue(theta);
+        if self.squared {
+            (point, SquaredShift::lambda_of_s(point))
+        } else {
+            (point, point)
         }
     }
 }
@@ -86,12 +72,16 @@ impl<'a> BandRun<'a> {
                         .into(),
                 );
             }
-            return Ok(WindowOp::Squared(QepSquaredShift::new(qep, sigma)?));
+            return Ok(WindowOp {
+                op: Box::new(SquaredShift::lu(qep, sigma)?),
+                squared: true,
+            });
         };
         let t = Instant::now();
         let shift = SymmetricShift::new(ctx.op, ctx.pencil.clone(), &ctx.friction, sigma)?;
         let t_factor = t.elapsed().as_secs_f64();
-        let op = QepLowRankSquared::new(qep, Arc::new(shift), ctx.mu)?;
+        let op = SquaredShift::low_rank(qep, Arc::new(shift), ctx.mu)?;
+        let woodbury = op.woodbury().expect("built on the low-rank path");
         if first {
             self.info.notes.push(format!(
                 "C = 0: real shift-invert of K - s M, s = -lambda^2 (squared \
@@ -105,16 +95,19 @@ impl<'a> BandRun<'a> {
                 ctx.friction.rank(),
                 ctx.friction.identity_error,
                 ctx.pencil.asymmetry(),
-                op.shift().s_residual(),
-                op.probe_residual(),
-                if op.refines() {
+                woodbury.shift().s_residual(),
+                woodbury.probe_residual(),
+                if woodbury.refines() {
                     ", one refinement step per solve"
                 } else {
                     ""
                 }
             ));
         }
-        Ok(WindowOp::LowRank(op))
+        Ok(WindowOp {
+            op: Box::new(op),
+            squared: true,
+        })
     }
 
     /// Covers `[lo, hi]` Hz with one shift, or splits it.
@@ -137,15 +130,19 @@ impl<'a> BandRun<'a> {
             let radius = self.options.radius_factor * half + self.options.margin_rel * two_pi * hi;
             let qep: &'a Qep = self.qep;
             let op = QepShiftInvert::with_symbolic(qep, sigma, self.symbolic()?)?;
-            (sigma, radius, WindowOp::Companion(op))
+            let op = WindowOp {
+                op: Box::new(op),
+                squared: false,
+            };
+            (sigma, radius, op)
         };
-        let dim = op.linop().dim();
+        let dim = op.op.dim();
         self.info.factorizations += 1;
         let mut nev = nev0.clamp(1, self.cap);
         let outcome = loop {
             let out =
                 self.kernel
-                    .largest(op.linop(), nev, self.params.tol, self.params.max_restarts)?;
+                    .largest(&*op.op, nev, self.params.tol, self.params.max_restarts)?;
             if out.vectors.nrows() != dim || out.vectors.ncols() < out.theta.len() {
                 return Err(Error::Dimension {
                     context: format!(
@@ -201,7 +198,7 @@ impl<'a> BandRun<'a> {
             ));
             nev = grown;
         };
-        self.info.op_applications += op.applications();
+        self.info.op_applications += op.op.applications();
         drop(op);
         let Some((out, lam)) = outcome else {
             let mid = 0.5 * (lo + hi);

@@ -2,8 +2,9 @@
 //! and the friction load directions ([`friction_load_directions`]).
 
 use super::sparse_times;
-use crate::contact::{BasisRequest, FrictionalOperator};
-use crate::eigen::{EigenParams, RealModes, SymmetricProblem};
+use crate::contact::BasisRequest;
+use crate::eigen::{EigenParams, SymmetricProblem};
+use crate::operator::{FrictionalOperator, RealModes};
 use crate::{Error, Result};
 use faer::Mat;
 

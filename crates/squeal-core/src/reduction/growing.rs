@@ -8,8 +8,8 @@ use super::orthonormal::m_orthonormal_extend_imaged;
 use super::project::{dense_to_sparse, project_loads, project_part};
 use super::statics::{energy_norms, StaticSolver};
 use super::{expand, sparse_times, tmul};
-use crate::contact::FrictionalOperator;
-use crate::qep::spmv_complex;
+use crate::linalg::spmv_complex;
+use crate::operator::FrictionalOperator;
 use crate::{c64, Error, Result, SparseMat};
 use faer::{Mat, MatRef};
 

@@ -6,7 +6,7 @@
 //! - the coupled mu = 0 real modes ([`coupled_real_modes`]), the friction load directions
 //!   ([`friction_load_directions`]) and static responses with one reused factorization
 //!   ([`StaticSolver`]);
-//! - projection of every part of a [`FrictionalOperator`](crate::contact::FrictionalOperator) on a basis ([`project`]), or of a
+//! - projection of every part of a [`FrictionalOperator`](crate::operator::FrictionalOperator) on a basis ([`project`]), or of a
 //!   basis grown column by column with the images of its columns kept ([`GrowingBasis`]), the
 //!   reduced solve with any [`EigenSolver`](crate::EigenSolver), and the expansion of the reduced modes with
 //!   their backward errors on the FULL operator ([`ReducedOperator`], [`solve_reduced`]);
@@ -29,7 +29,7 @@
 //! ## Reduced solve
 //! `V^T X V` for each part `X` in {`M_c`, `C_c`, `K_c`, `F_M`, `F_C`, `F_K`} (the friction
 //! parts have `4 nA` nonzero rows, so their projection is cheap), a dense-backed
-//! [`FrictionalOperator`](crate::contact::FrictionalOperator) with `t: None`, solved by any [`EigenSolver`](crate::EigenSolver) (normally `dense`)
+//! [`FrictionalOperator`](crate::operator::FrictionalOperator) with `t: None`, solved by any [`EigenSolver`](crate::EigenSolver) (normally `dense`)
 //! at each mu; the modes `u_c = V q` are finished by [`finish_operator_modes`](crate::qep::finish_operator_modes) on the
 //! parts of `op.at(mu)`, so their backward errors are those of the full problem. When the
 //! reduced solver returns left eigenvectors `p`, they are expanded the same way

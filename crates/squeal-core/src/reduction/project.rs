@@ -2,8 +2,8 @@
 //! [`project`]) and expansion of reduced vectors (`u = V q`, [`expand`]).
 
 use super::{par, tmul};
-use crate::contact::FrictionalOperator;
 use crate::linalg::sparse_transpose_times;
+use crate::operator::FrictionalOperator;
 use crate::{c64, Error, Result, SparseMat, SparseRef};
 use faer::linalg::matmul::matmul;
 use faer::sparse::Triplet;

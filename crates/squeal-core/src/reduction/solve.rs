@@ -2,9 +2,10 @@
 //! solved at any mu, its modes expanded with backward errors on the full operator.
 
 use super::{expand, project};
-use crate::contact::{Basis, FrictionalOperator};
+use crate::contact::Basis;
 use crate::eigen::{EigenParams, EigenSolver};
-use crate::qep::{finish_operator_modes, finish_operator_modes_with_left, ComplexModes};
+use crate::operator::{ComplexModes, FrictionalOperator};
+use crate::qep::{finish_operator_modes, finish_operator_modes_with_left};
 use crate::{c64, Error, Result};
 use faer::Mat;
 use std::time::Instant;

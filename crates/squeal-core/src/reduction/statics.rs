@@ -2,9 +2,9 @@
 //! energy-norm residuals of reduced modes ([`energy_residuals`]).
 
 use super::sparse_times;
-use crate::contact::FrictionalOperator;
+use crate::linalg::spmv_complex;
 use crate::linalg::{add_scaled, Cholesky};
-use crate::qep::spmv_complex;
+use crate::operator::FrictionalOperator;
 use crate::{c64, Error, Result, SparseMat, SparseRef};
 use faer::{Mat, MatRef};
 use std::time::Instant;
@@ -56,7 +56,7 @@ impl StaticSolver {
 /// `eps_j = sqrt(d_j^H K_s d_j) / sqrt(u_j^H K_s u_j)`. Returns the `eps_j` and the
 /// static responses `d_j` (complex, one column each).
 pub fn energy_residuals(
-    qep: &crate::qep::Qep,
+    qep: &crate::operator::Qep,
     ks: &StaticSolver,
     lambda: &[c64],
     u: MatRef<'_, c64>,

@@ -1,13 +1,13 @@
 use super::project::dense_to_sparse;
 use super::*;
-use crate::contact::{Basis, BasisRequest, FrictionalOperator};
+use crate::contact::{Basis, BasisRequest};
 use crate::eigen::{
-    dense_symmetric, finish_real_modes, EigenParams, EigenSolver, RealModes, SolveInfo,
-    SymmetricProblem,
+    dense_symmetric, finish_real_modes, EigenParams, EigenSolver, SymmetricProblem,
 };
 use crate::linalg::{dot, spmv};
+use crate::operator::{ComplexModes, FrictionalOperator, Qep, RealModes, SolveInfo};
 use crate::qep::finish_modes;
-use crate::qep::{backward_error, dense_qep, ComplexModes, Qep};
+use crate::qep::{backward_error, dense_qep};
 use crate::{c64, Result, SparseMat};
 
 /// Deterministic pseudo-random numbers in [-0.5, 0.5).

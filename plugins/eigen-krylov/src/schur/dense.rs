@@ -6,11 +6,12 @@ use super::*;
 use squeal_core::faer::linalg::matmul::matmul;
 use squeal_core::faer::linalg::solvers::Solve;
 use squeal_core::faer::{Accum, Mat, MatMut, MatRef};
-use squeal_core::qep::{ComplexKernelOutput, ComplexLinOp};
+use squeal_core::qep::ComplexKernelOutput;
+use squeal_core::spectral::LinOp;
 use squeal_core::{c64, Error, Result};
 
 /// `nev >= n`: every eigenpair of the operator, densely.
-pub(super) fn dense_fallback(op: &dyn ComplexLinOp, nev: usize) -> Result<ComplexKernelOutput> {
+pub(super) fn dense_fallback(op: &dyn LinOp<c64>, nev: usize) -> Result<ComplexKernelOutput> {
     let n = op.dim();
     if n > DENSE_MAX {
         return Err(Error::param(

@@ -3,7 +3,8 @@
 use super::*;
 use squeal_core::faer::linalg::matmul::matmul;
 use squeal_core::faer::{Accum, Mat, MatRef};
-use squeal_core::qep::{ComplexKernelOutput, ComplexLinOp};
+use squeal_core::qep::ComplexKernelOutput;
+use squeal_core::spectral::LinOp;
 use squeal_core::{c64, Error, Result};
 
 /// The Arnoldi basis (`cap` columns), column-major.
@@ -90,7 +91,7 @@ pub(super) struct RunOut {
 
 /// State shared by the runs of one [`KrylovSchurKernel::largest`] call.
 pub(super) struct Ctx<'o> {
-    pub(super) op: &'o dyn ComplexLinOp,
+    pub(super) op: &'o dyn LinOp<c64>,
     pub(super) tol: f64,
     pub(super) max_restarts: usize,
     pub(super) restarts: usize,

@@ -108,7 +108,8 @@ use super::{
     par_for, Directions, BREAKDOWN, CHECK_EVERY, NEW_DIRECTION_MIN, NEW_DIRECTION_TRIES, THIRD_PASS,
 };
 use squeal_core::faer::Mat;
-use squeal_core::qep::{ComplexKernel, ComplexKernelOutput, ComplexLinOp};
+use squeal_core::qep::{ComplexKernel, ComplexKernelOutput};
+use squeal_core::spectral::LinOp;
 use squeal_core::{c64, Error, Result};
 
 mod dense;
@@ -142,7 +143,7 @@ pub struct KrylovSchurKernel;
 impl ComplexKernel for KrylovSchurKernel {
     fn largest(
         &self,
-        op: &dyn ComplexLinOp,
+        op: &dyn LinOp<c64>,
         nev: usize,
         tol: f64,
         max_restarts: usize,

@@ -26,7 +26,7 @@ impl Rng {
 /// A dense operator.
 struct Dense(Mat<c64>);
 
-impl ComplexLinOp for Dense {
+impl LinOp<c64> for Dense {
     fn dim(&self) -> usize {
         self.0.nrows()
     }
@@ -91,7 +91,7 @@ fn top(d: &[c64], k: usize) -> Vec<c64> {
 }
 
 /// Max relative residual `||OP v - theta v|| / (|theta| ||v||)` of the output.
-fn max_residual(op: &dyn ComplexLinOp, out: &ComplexKernelOutput) -> f64 {
+fn max_residual(op: &dyn LinOp<c64>, out: &ComplexKernelOutput) -> f64 {
     let n = op.dim();
     let mut y = vec![ZERO; n];
     let mut worst: f64 = 0.0;
@@ -354,7 +354,7 @@ impl TridiagShiftInvert {
     }
 }
 
-impl ComplexLinOp for TridiagShiftInvert {
+impl LinOp<c64> for TridiagShiftInvert {
     fn dim(&self) -> usize {
         self.n
     }
@@ -420,7 +420,7 @@ fn timing_tridiagonal_n20000_nev40() {
 }
 
 struct DiagOp(Vec<c64>);
-impl ComplexLinOp for DiagOp {
+impl LinOp<c64> for DiagOp {
     fn dim(&self) -> usize {
         self.0.len()
     }

@@ -1,7 +1,7 @@
-use super::super::{dense_qep, finish_modes, ComplexModes, Qep};
+use super::super::{dense_qep, finish_modes};
 use super::*;
-use crate::contact::FrictionalOperator;
-use crate::eigen::{EigenParams, EigenSolver, RealModes, SolveInfo, SymmetricProblem};
+use crate::eigen::{EigenParams, EigenSolver, SymmetricProblem};
+use crate::operator::{ComplexModes, FrictionalOperator, Qep, RealModes, SolveInfo};
 use crate::reduction::{m_orthonormalize, ReducedOperator};
 use crate::{Basis, SparseMat};
 use faer::sparse::Triplet;

@@ -1,22 +1,17 @@
-//! Shared sparse linear algebra: combinations, products, norms and the symmetric
-//! shift-invert operator that every symmetric eigen backend drives.
-//!
-//! The shift-invert operator of the generalized problem `K x = lambda M x` is
-//! `OP = (K - sigma M)^-1 M`. It is self-adjoint in the `M` inner product and its
-//! eigenvalues `theta = 1 / (lambda - sigma)` are largest for the `lambda` nearest
-//! `sigma`. With `sigma` below the spectrum, `K - sigma M` is positive definite and
-//! one sparse Cholesky factorization (faer supernodal, ordered by
-//! [`crate::ordering`]) serves every application.
+//! Shared sparse linear algebra: combinations, products (real and complex), norms and the
+//! sparse Cholesky factorization every symmetric solve uses ([`Cholesky`]).
 
-use crate::ordering::{symmetric_ordering, FillOrdering};
+mod cholesky;
+mod complex;
+
+pub use cholesky::Cholesky;
+pub(crate) use cholesky::{LltFailure, SparseLlt};
+pub use complex::spmv_complex;
+pub(crate) use complex::{norm2_c, spmv_complex_add, spmv_complex_split};
+
 use crate::{Error, Result, SparseMat, SparseRef};
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
-};
 use faer::sparse::Triplet;
-use faer::{Conj, Mat, MatMut, MatRef, Par, Side};
+use faer::{Mat, MatMut, MatRef, Par};
 
 /// `alpha A + beta B` for square sparse matrices of the same size (patterns may differ).
 pub fn add_scaled(a: SparseRef<'_>, alpha: f64, b: SparseRef<'_>, beta: f64) -> Result<SparseMat> {
@@ -284,228 +279,9 @@ pub fn check_square_finite(a: SparseRef<'_>, n: usize, what: &str) -> Result<()>
     Ok(())
 }
 
-/// A sparse supernodal `A = L L^T` (faer) in the fill-reducing ordering of
-/// [`FillOrdering::of`]: the symbolic analysis and the values of `L`.
-struct SparseLlt {
-    symbolic: SymbolicCholesky<usize>,
-    values: Vec<f64>,
-}
-
-/// Why a [`SparseLlt`] failed: its symbolic analysis (and ordering), or its numeric
-/// factorization (the matrix is not positive definite).
-enum LltFailure {
-    Symbolic(String),
-    Numeric(String),
-}
-
-impl SparseLlt {
-    /// Orders, analyses and factorizes the lower triangle of `a`.
-    fn new(a: SparseRef<'_>) -> std::result::Result<Self, LltFailure> {
-        let ordering =
-            FillOrdering::of(a.symbolic()).map_err(|e| LltFailure::Symbolic(e.to_string()))?;
-        let symbolic = factorize_symbolic_cholesky(
-            a.symbolic(),
-            Side::Lower,
-            symmetric_ordering(ordering.as_ref()),
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(|e| LltFailure::Symbolic(format!("{e:?}")))?;
-        let mut values = Vec::new();
-        values.try_reserve_exact(symbolic.len_val()).map_err(|_| {
-            LltFailure::Symbolic(format!(
-                "out of memory for {} entries of L",
-                symbolic.len_val()
-            ))
-        })?;
-        values.resize(symbolic.len_val(), 0.0);
-        let par = faer::get_global_parallelism();
-        let mut mem = MemBuffer::try_new(
-            symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
-        )
-        .map_err(|_| {
-            LltFailure::Symbolic("out of memory for the factorization's workspace".into())
-        })?;
-        symbolic
-            .factorize_numeric_llt(
-                &mut values,
-                a,
-                Side::Lower,
-                LltRegularization::default(),
-                par,
-                MemStack::new(&mut mem),
-                Default::default(),
-            )
-            .map_err(|e| LltFailure::Numeric(format!("{e:?}")))?;
-        Ok(Self { symbolic, values })
-    }
-
-    /// Entries stored in `L`.
-    fn factor_entries(&self) -> usize {
-        self.symbolic.len_val()
-    }
-
-    /// `B <- A^-1 B`.
-    fn solve_in_place(&self, b: MatMut<'_, f64>) {
-        let par = faer::get_global_parallelism();
-        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(b.ncols(), par));
-        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
-            Conj::No,
-            b,
-            par,
-            MemStack::new(&mut mem),
-        );
-    }
-}
-
-/// A sparse Cholesky factorization `A = L L^T` of a symmetric positive definite matrix
-/// (faer supernodal, ordered by [`crate::ordering`]), solved against one or many
-/// right-hand sides.
-pub struct Cholesky {
-    llt: SparseLlt,
-    n: usize,
-}
-
-impl Cholesky {
-    /// Factorizes `a`; `what` names the matrix in errors.
-    pub fn new(a: SparseRef<'_>, what: &str) -> Result<Self> {
-        let n = a.nrows();
-        check_square_finite(a, n, what)?;
-        let llt = SparseLlt::new(a).map_err(|f| Error::Factorization {
-            what: format!("{what} (n = {n})"),
-            reason: match f {
-                LltFailure::Symbolic(e) => e,
-                LltFailure::Numeric(e) => {
-                    format!("{e} (not positive definite: are the rigid-body motions restrained?)")
-                }
-            },
-        })?;
-        Ok(Self { llt, n })
-    }
-
-    /// Size.
-    pub fn dim(&self) -> usize {
-        self.n
-    }
-
-    /// Entries stored in the factor `L`.
-    pub fn factor_entries(&self) -> usize {
-        self.llt.factor_entries()
-    }
-
-    /// `B <- A^-1 B` for a block of right-hand sides (columns).
-    pub fn solve_in_place(&self, b: MatMut<'_, f64>) {
-        self.llt.solve_in_place(b);
-    }
-
-    /// `y <- A^-1 y`.
-    pub fn solve_vec_in_place(&self, y: &mut [f64]) {
-        let n = y.len();
-        self.llt
-            .solve_in_place(MatMut::from_column_major_slice_mut(y, n, 1));
-    }
-}
-
-/// The factorized symmetric shift-invert operator `OP = (K - sigma M)^-1 M`.
-pub struct ShiftInvert<'a> {
-    m: SparseRef<'a>,
-    sigma: f64,
-    llt: SparseLlt,
-    applications: std::sync::atomic::AtomicUsize,
-}
-
-impl<'a> ShiftInvert<'a> {
-    /// Factorizes `K - sigma M` (Cholesky). `sigma` must lie below the spectrum so that
-    /// the shifted matrix is positive definite; the error says so otherwise.
-    pub fn new(k: SparseRef<'_>, m: SparseRef<'a>, sigma: f64) -> Result<Self> {
-        let n = k.nrows();
-        check_square_finite(k, n, "K")?;
-        check_square_finite(m, n, "M")?;
-        let shifted = add_scaled(k, 1.0, m, -sigma)?;
-        let fail = |reason: String| Error::Factorization {
-            what: format!("K - sigma M (sigma = {sigma:.6e} (rad/s)^2, n = {n})"),
-            reason,
-        };
-        let llt = SparseLlt::new(shifted.as_ref()).map_err(|f| match f {
-            LltFailure::Symbolic(e) => fail(e),
-            LltFailure::Numeric(e) => fail(format!(
-                "{e} (not positive definite: is sigma below the lowest eigenvalue, \
-                 and are the rigid-body motions of K restrained or M positive?)"
-            )),
-        })?;
-        Ok(Self {
-            m,
-            sigma,
-            llt,
-            applications: std::sync::atomic::AtomicUsize::new(0),
-        })
-    }
-
-    /// Problem size.
-    pub fn dim(&self) -> usize {
-        self.m.nrows()
-    }
-
-    /// The shift `sigma`, in (rad/s)^2.
-    pub fn sigma(&self) -> f64 {
-        self.sigma
-    }
-
-    /// The mass matrix.
-    pub fn m(&self) -> SparseRef<'a> {
-        self.m
-    }
-
-    /// `y = M x`.
-    pub fn m_mul(&self, x: &[f64], y: &mut [f64]) {
-        spmv(self.m, x, y);
-    }
-
-    /// `y <- (K - sigma M)^-1 y`.
-    pub fn solve_in_place(&self, y: &mut [f64]) {
-        let n = y.len();
-        let mat = MatMut::from_column_major_slice_mut(y, n, 1);
-        self.llt.solve_in_place(mat);
-    }
-
-    /// `y = (K - sigma M)^-1 M x`, the operator application.
-    pub fn apply(&self, x: &[f64], y: &mut [f64]) {
-        self.m_mul(x, y);
-        self.solve_in_place(y);
-        self.applications
-            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    }
-
-    /// `y = (K - sigma M)^-1 b` where `b = M x` is already known (saves one product).
-    pub fn apply_with_mx(&self, mx: &[f64], y: &mut [f64]) {
-        y.copy_from_slice(mx);
-        self.solve_in_place(y);
-        self.applications
-            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    }
-
-    /// How many times the operator was applied (a cost measure reported by solvers).
-    pub fn applications(&self) -> usize {
-        self.applications.load(std::sync::atomic::Ordering::Relaxed)
-    }
-
-    /// Back-transforms an operator eigenvalue `theta` to `lambda = sigma + 1 / theta`.
-    pub fn lambda_of_theta(&self, theta: f64) -> f64 {
-        self.sigma + 1.0 / theta
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn diag(v: &[f64]) -> SparseMat {
-        let t: Vec<_> = v
-            .iter()
-            .enumerate()
-            .map(|(i, &x)| Triplet::new(i, i, x))
-            .collect();
-        SparseMat::try_new_from_triplets(v.len(), v.len(), &t).unwrap()
-    }
 
     #[test]
     fn sparse_times_gives_the_bits_of_faers_product_for_every_block_width() {
@@ -636,41 +412,5 @@ mod tests {
             .filter(|&(i, j)| da[(i, j)] != 0.0 || db[(i, j)] != 0.0)
             .count();
         assert_eq!(c.compute_nnz(), union, "the pattern is the union of both");
-    }
-
-    #[test]
-    fn shift_invert_on_a_diagonal_pencil() {
-        let k = diag(&[1.0, 4.0, 9.0]);
-        let m = diag(&[1.0, 2.0, 3.0]);
-        let op = ShiftInvert::new(k.as_ref(), m.as_ref(), -1.0).unwrap();
-        let mut y = vec![0.0; 3];
-        op.apply(&[1.0, 1.0, 1.0], &mut y);
-        // (k_i + m_i)^-1 m_i
-        approx::assert_relative_eq!(y[0], 0.5, epsilon = 1e-14);
-        approx::assert_relative_eq!(y[1], 2.0 / 6.0, epsilon = 1e-14);
-        approx::assert_relative_eq!(y[2], 3.0 / 12.0, epsilon = 1e-14);
-        assert_eq!(op.applications(), 1);
-        approx::assert_relative_eq!(op.lambda_of_theta(0.5), 1.0, epsilon = 1e-14);
-    }
-
-    #[test]
-    fn shift_above_spectrum_is_a_clear_error() {
-        let k = diag(&[1.0, 4.0]);
-        let m = diag(&[1.0, 1.0]);
-        let e = ShiftInvert::new(k.as_ref(), m.as_ref(), 2.0)
-            .err()
-            .expect("indefinite shift must fail")
-            .to_string();
-        assert!(
-            e.contains("sigma") && e.contains("positive definite"),
-            "{e}"
-        );
-    }
-
-    #[test]
-    fn non_finite_matrix_is_rejected() {
-        let k = diag(&[1.0, f64::NAN]);
-        let m = diag(&[1.0, 1.0]);
-        assert!(ShiftInvert::new(k.as_ref(), m.as_ref(), 0.0).is_err());
     }
 }

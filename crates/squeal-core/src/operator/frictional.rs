@@ -1,7 +1,7 @@
 //! The constrained frictional operator of one contact set ([`FrictionalOperator`]).
 
 use crate::linalg::add_scaled;
-use crate::qep::Qep;
+use crate::operator::Qep;
 use crate::{Error, Result, SparseMat};
 
 /// The constrained frictional operator of one contact set: the mu-independent parts

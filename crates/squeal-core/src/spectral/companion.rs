@@ -1,10 +1,9 @@
-//! Shift-invert operators of the QEP: the companion form at a complex shift
-//! ([`QepShiftInvert`], on a reusable symbolic analysis [`QepSymbolic`]) and the real
-//! squared transformation of an undamped problem ([`QepSquaredShift`]).
+//! The shift-invert transformation of a QEP in companion form at a complex shift
+//! ([`QepShiftInvert`], on a reusable symbolic analysis [`QepSymbolic`]).
 
-use super::vector::{spmv_complex, spmv_complex_add, spmv_complex_split};
-use super::{check_qep, ComplexLinOp, Qep};
-use crate::contact::FrictionalOperator;
+use super::{LinOp, SpectralTransform};
+use crate::linalg::{spmv_complex, spmv_complex_add};
+use crate::operator::{check_qep, FrictionalOperator, Qep};
 use crate::{c64, Error, Result, SparseMat, SparseRef};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
@@ -209,21 +208,9 @@ impl<'a> QepShiftInvert<'a> {
         })
     }
 
-    /// The shift.
-    pub fn sigma(&self) -> c64 {
-        self.sigma
-    }
     /// The problem it was built for.
     pub fn qep(&self) -> &Qep {
         self.qep
-    }
-    /// `lambda = sigma + 1/theta`.
-    pub fn lambda_of_theta(&self, theta: c64) -> c64 {
-        self.sigma + c64::new(1.0, 0.0) / theta
-    }
-    /// How many times the operator was applied (one sparse solve each).
-    pub fn applications(&self) -> usize {
-        self.applications.load(Ordering::Relaxed)
     }
     /// `y <- Q(sigma)^-1 y` (length `n`, not counted as an application).
     pub fn solve_in_place(&self, y: &mut [c64]) {
@@ -240,7 +227,17 @@ impl<'a> QepShiftInvert<'a> {
     }
 }
 
-impl ComplexLinOp for QepShiftInvert<'_> {
+impl SpectralTransform<c64> for QepShiftInvert<'_> {
+    /// The shift `sigma` (rad/s); `lambda = sigma + 1/theta`.
+    fn shift(&self) -> c64 {
+        self.sigma
+    }
+    fn applications(&self) -> usize {
+        self.applications.load(Ordering::Relaxed)
+    }
+}
+
+impl LinOp<c64> for QepShiftInvert<'_> {
     fn dim(&self) -> usize {
         2 * self.qep.dim()
     }
@@ -273,86 +270,6 @@ impl ComplexLinOp for QepShiftInvert<'_> {
         for ((v1, v2), &b1) in y1.iter_mut().zip(y2.iter_mut()).zip(x1) {
             *v1 = -*v1;
             *v2 = b1 + self.sigma * *v1;
-        }
-        self.applications.fetch_add(1, Ordering::Relaxed);
-    }
-}
-
-/// The cheaper spectral transformation of an undamped QEP (`C = 0`):
-/// `(lambda^2 M + K) u = 0` is `(K - s M) u = 0` with `s = -lambda^2`, so
-/// `OP = (K - sigma_s M)^-1 M` on `n`-vectors with a REAL shift `sigma_s` and one real
-/// sparse LU (a quarter of the work and half the memory of a complex one, on half the
-/// vector length). Eigenvalues map back as `s = sigma_s + 1/theta`,
-/// `lambda = i sqrt(s)` (principal root, so `Im(lambda) >= 0`); the conjugate `s` gives
-/// the mirror mode `-conj(lambda)`. Complex vectors are applied as two real columns.
-pub struct QepSquaredShift<'a> {
-    qep: &'a Qep,
-    sigma: f64,
-    lu: Lu<usize, f64>,
-    applications: AtomicUsize,
-}
-
-impl<'a> QepSquaredShift<'a> {
-    /// Factorizes `K - sigma_s M` (real, non-symmetric in general). `qep.c` must be `None`.
-    pub fn new(qep: &'a Qep, sigma_s: f64) -> Result<Self> {
-        check_qep(qep)?;
-        if qep.c.is_some() {
-            return Err(Error::Invalid(
-                "the squared spectral transformation needs C = 0".into(),
-            ));
-        }
-        let n = qep.dim();
-        let a = crate::linalg::add_scaled(qep.k.as_ref(), 1.0, qep.m.as_ref(), -sigma_s)?;
-        let what = || format!("K - s M (s = {sigma_s:.6e} (rad/s)^2, n = {n})");
-        let sym = SymbolicLu::try_new(a.symbolic()).map_err(|e| Error::Factorization {
-            what: what(),
-            reason: format!("{e:?}"),
-        })?;
-        let lu = Lu::try_new_with_symbolic(sym, a.as_ref()).map_err(|e| Error::Factorization {
-            what: what(),
-            reason: format!("{e:?}"),
-        })?;
-        let mut y: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
-        lu.solve_in_place(MatMut::from_column_major_slice_mut(&mut y, n, 1));
-        if y.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Factorization {
-                what: what(),
-                reason: "numerically singular (is the shift an eigenvalue?)".into(),
-            });
-        }
-        Ok(Self {
-            qep,
-            sigma: sigma_s,
-            lu,
-            applications: AtomicUsize::new(0),
-        })
-    }
-
-    /// How many times the operator was applied.
-    pub fn applications(&self) -> usize {
-        self.applications.load(Ordering::Relaxed)
-    }
-
-    /// `s = sigma_s + 1/theta` and `lambda = i sqrt(s)`.
-    pub fn lambda_of_theta(&self, theta: c64) -> (c64, c64) {
-        let s = c64::new(self.sigma, 0.0) + c64::new(1.0, 0.0) / theta;
-        (s, c64::new(0.0, 1.0) * s.sqrt())
-    }
-}
-
-impl ComplexLinOp for QepSquaredShift<'_> {
-    fn dim(&self) -> usize {
-        self.qep.dim()
-    }
-
-    fn apply(&self, x: &[c64], y: &mut [c64]) {
-        let n = self.qep.dim();
-        assert_eq!(x.len(), n, "QepSquaredShift::apply: x has the wrong length");
-        assert_eq!(y.len(), n, "QepSquaredShift::apply: y has the wrong length");
-        let mut b = spmv_complex_split(self.qep.m.as_ref(), x);
-        self.lu.solve_in_place(b.as_mut());
-        for (i, v) in y.iter_mut().enumerate() {
-            *v = c64::new(b[(i, 0)], b[(i, 1)]);
         }
         self.applications.fetch_add(1, Ordering::Relaxed);
     }

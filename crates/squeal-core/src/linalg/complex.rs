@@ -10,7 +10,7 @@ pub fn spmv_complex(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
 }
 
 /// `y += A x` for a real sparse matrix and a complex vector.
-pub(super) fn spmv_complex_add(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
+pub(crate) fn spmv_complex_add(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
     debug_assert_eq!(x.len(), a.ncols());
     debug_assert_eq!(y.len(), a.nrows());
     for j in 0..a.ncols() {
@@ -41,7 +41,7 @@ pub(crate) fn spmv_complex_split(a: SparseRef<'_>, x: &[c64]) -> Mat<f64> {
     b
 }
 
-pub(super) fn norm2_c(x: &[c64]) -> f64 {
+pub(crate) fn norm2_c(x: &[c64]) -> f64 {
     x.iter()
         .map(|v| v.re * v.re + v.im * v.im)
         .sum::<f64>()
