@@ -31,7 +31,7 @@
 //! |  2 | `y = M x` | `op.m_mul(x, y)` |
 //!
 //! `dseupd` returns the Ritz values back-transformed, `lambda = sigma + 1 / theta`; the
-//! kernel converts them back to `theta` (the [`SymmetricKernel`] contract), and the band
+//! kernel converts them back to `theta` (the [`SymmetricKernel`](squeal_core::SymmetricKernel) contract), and the band
 //! driver of squeal-core does the back-transformation, `M`-normalization, residuals and
 //! band selection once for every backend.
 //!
@@ -40,7 +40,7 @@
 //!
 //! ## Complex modes of the frictional QEP
 //!
-//! [`EigenSolver::solve_qep`] runs the band driver of squeal-core
+//! [`EigenSolver::solve_qep`](squeal_core::EigenSolver::solve_qep) runs the band driver of squeal-core
 //! ([`squeal_core::qep::solve_qep_band`]) with [`ArpackComplexKernel`]: ARPACK's complex
 //! Arnoldi iteration `znaupd`/`zneupd` in *standard mode 1* (`bmat = 'I'`,
 //! `which = "LM"`) on the user operator `OP = (A - sigma B)^-1 B` of the companion form
