@@ -39,24 +39,30 @@ impl SceneCmd {
     }
 }
 
-/// Measured wall times of `squeal validate` on a 2-core machine, `(free DOFs, seconds)`:
-/// the embedded `pin-on-disc-coarse` and `pin-on-disc` scenes. They calibrate
-/// [`validate_estimate_s`].
-const VALIDATE_RUNS: [(f64, f64); 2] = [(1_779.0, 2.4), (171_963.0, 725.0)];
+/// Measured wall times of `squeal validate` on a 2-core machine, `(free DOFs, seconds)`,
+/// by size: the embedded `pin-on-disc-coarse`, `pin-on-disc` and `pin-on-disc-paper`
+/// scenes. They calibrate [`validate_estimate_s`].
+const VALIDATE_RUNS: [(f64, f64); 3] = [(1_779.0, 2.4), (171_963.0, 725.0), (330_306.0, 1_672.0)];
 
-/// Exponent of the power law `t = t0 (n / n0)^p` through the two [`VALIDATE_RUNS`].
-fn validate_exponent() -> f64 {
-    let [(n0, t0), (n1, t1)] = VALIDATE_RUNS;
+/// Exponent of the power law `t = t0 (n / n0)^p` between measured runs `i` and `i + 1`.
+fn segment_exponent(i: usize) -> f64 {
+    let ((n0, t0), (n1, t1)) = (VALIDATE_RUNS[i], VALIDATE_RUNS[i + 1]);
     (t1 / t0).ln() / (n1 / n0).ln()
 }
 
 /// Estimated wall time (s) of `squeal validate` on a scene of `dofs` free DOFs on a
-/// 2-core machine: the power law through the two measured [`VALIDATE_RUNS`]. An
-/// estimate: the stages (disc modes, equilibria, sweeps, full-order reference points)
-/// do not all scale alike, and other machines differ.
+/// 2-core machine: the power law between the two measured [`VALIDATE_RUNS`] around
+/// `dofs` (the nearest pair outside them). An estimate: the stages (disc modes,
+/// equilibria, sweeps, full-order reference points) do not all scale alike, and other
+/// machines differ.
 pub fn validate_estimate_s(dofs: usize) -> f64 {
-    let (n0, t0) = VALIDATE_RUNS[0];
-    t0 * (dofs as f64 / n0).powf(validate_exponent())
+    let n = dofs as f64;
+    let last = VALIDATE_RUNS.len() - 2;
+    let i = (0..=last)
+        .find(|&i| n <= VALIDATE_RUNS[i + 1].0)
+        .unwrap_or(last);
+    let (n0, t0) = VALIDATE_RUNS[i];
+    t0 * (n / n0).powf(segment_exponent(i))
 }
 
 /// A duration estimate with two significant digits at most: `~7 s`, `~4 min`, `~77 min`,
@@ -99,14 +105,19 @@ fn list(registry: &Registry) -> Result<()> {
             scene.description
         );
     }
-    let [(n0, t0), (n1, t1)] = VALIDATE_RUNS;
+    let runs: Vec<String> = VALIDATE_RUNS
+        .iter()
+        .map(|&(n, t)| format!("{n} DOFs in {}", approx_duration(t).trim_start_matches('~')))
+        .collect();
+    let exponents: Vec<String> = (0..VALIDATE_RUNS.len() - 1)
+        .map(|i| format!("{:.2}", segment_exponent(i)))
+        .collect();
     println!(
         "\nvalidate (est.): an estimate of the wall time of `squeal validate SCENE` on a \
-         2-core machine, t = {t0} s x (DOFs / {n0})^{:.2}: the power law through two measured \
-         runs ({n0} DOFs in {t0} s, {n1} DOFs in {:.0} min); other machines and scenes that \
-         scale differently will differ.",
-        validate_exponent(),
-        t1 / 60.0
+         2-core machine, t ~ DOFs^p between the measured runs around the scene's size ({}; \
+         p = {}); other machines and scenes that scale differently will differ.",
+        runs.join(", "),
+        exponents.join(", ")
     );
     println!(
         "\nUse a name as SCENE (`squeal stability pin-on-disc-coarse`), or a scene file; \
@@ -226,9 +237,23 @@ mod tests {
                 "{n} DOFs: {e} s, measured {t} s"
             );
         }
-        // growing with the size, faster than linearly but slower than quadratically
-        let (a, b) = (validate_estimate_s(100_000), validate_estimate_s(200_000));
-        assert!(b > 2.0 * a && b < 4.0 * a, "{a} {b}");
+        // growing with the size, faster than linearly but slower than quadratically,
+        // continuous across the measured sizes and beyond the largest
+        for (a, b) in [(100_000, 200_000), (200_000, 400_000), (400_000, 800_000)] {
+            let (ta, tb) = (validate_estimate_s(a), validate_estimate_s(b));
+            assert!(tb > 2.0 * ta && tb < 4.0 * ta, "{a}: {ta} s, {b}: {tb} s");
+        }
+        for &(n, _) in &VALIDATE_RUNS {
+            // one DOF either side: the change of a power law of exponent < 2, no jump
+            let (below, above) = (
+                validate_estimate_s(n as usize - 1),
+                validate_estimate_s(n as usize + 1),
+            );
+            assert!(
+                (above / below - 1.0).abs() < 4.0 / n,
+                "{n}: {below} {above}"
+            );
+        }
     }
 
     #[test]

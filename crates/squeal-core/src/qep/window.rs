@@ -5,7 +5,7 @@ use super::band::{LowRankCtx, QepBandOptions};
 use super::residual::{backward_error_with, QepNorms};
 use super::ComplexKernel;
 use crate::eigen::EigenParams;
-use crate::lowrank::SymmetricShift;
+use crate::lowrank::{SymmetricShift, Woodbury};
 use crate::operator::{Qep, SolveInfo, StopReason};
 use crate::spectral::{QepShiftInvert, QepSymbolic, SpectralTransform, SquaredShift};
 use crate::{c64, Error, Result};
@@ -80,8 +80,7 @@ impl<'a> BandRun<'a> {
         let t = Instant::now();
         let shift = SymmetricShift::new(ctx.op, ctx.pencil.clone(), &ctx.friction, sigma)?;
         let t_factor = t.elapsed().as_secs_f64();
-        let op = SquaredShift::low_rank(qep, Arc::new(shift), ctx.mu)?;
-        let woodbury = op.woodbury().expect("built on the low-rank path");
+        let woodbury = Woodbury::new(qep, Arc::new(shift), ctx.mu)?;
         if first {
             self.info.notes.push(format!(
                 "C = 0: real shift-invert of K - s M, s = -lambda^2 (squared \
@@ -105,7 +104,7 @@ impl<'a> BandRun<'a> {
             ));
         }
         Ok(WindowOp {
-            op: Box::new(op),
+            op: Box::new(SquaredShift::woodbury(qep, woodbury)?),
             squared: true,
         })
     }

@@ -19,7 +19,7 @@ use std::sync::Arc;
 /// work and half the memory of the companion form's complex LU, on half the vector
 /// length). `K - sigma_s M` is solved by a real sparse LU ([`lu`](Self::lu)) or, for a
 /// frictional operator, by the Woodbury identity on a symmetric factor
-/// ([`low_rank`](Self::low_rank)). Eigenvalues map back as `s = sigma_s + 1/theta`,
+/// ([`low_rank`](Self::low_rank), [`woodbury`](Self::woodbury)). Eigenvalues map back as `s = sigma_s + 1/theta`,
 /// `lambda = i sqrt(s)` ([`lambda_of_s`](Self::lambda_of_s), principal root, so
 /// `Im(lambda) >= 0`); the conjugate `s` gives the mirror mode `-conj(lambda)`. Complex
 /// vectors are applied as two real columns.
@@ -76,9 +76,13 @@ impl<'a> SquaredShift<'a> {
     /// The transformation of `qep = op.at(mu)` (undamped) at the shift `shift.s()`
     /// through the low-rank structure ([`Woodbury::new`]).
     pub fn low_rank(qep: &'a Qep, shift: Arc<SymmetricShift>, mu: f64) -> Result<Self> {
+        Self::woodbury(qep, Woodbury::new(qep, shift, mu)?)
+    }
+
+    /// The transformation of `qep` by a Woodbury solver built for it.
+    pub fn woodbury(qep: &'a Qep, solver: Woodbury<'a>) -> Result<Self> {
         undamped(qep)?;
-        let sigma = shift.s();
-        let solver = Woodbury::new(qep, shift, mu)?;
+        let sigma = solver.shift().s();
         Ok(Self::with(qep, sigma, ShiftedSolve::Woodbury(solver)))
     }
 
@@ -88,14 +92,6 @@ impl<'a> SquaredShift<'a> {
             sigma,
             solve,
             applications: AtomicUsize::new(0),
-        }
-    }
-
-    /// The Woodbury solver when built by [`low_rank`](Self::low_rank).
-    pub fn woodbury(&self) -> Option<&Woodbury<'a>> {
-        match &self.solve {
-            ShiftedSolve::Woodbury(w) => Some(w),
-            ShiftedSolve::Lu(_) => None,
         }
     }
 

@@ -29,7 +29,8 @@ impl FreeInterface {
     /// definite) for the candidate `pairs`, with the free-interface `modes` (of the same
     /// `(K, M)`, `M`-orthonormal, e.g. from an [`EigenSolver`](squeal_core::EigenSolver) up to a
     /// cutoff above the band). The static responses of the pairs are stored when they fit
-    /// in [`STORE_LIMIT_BYTES`], otherwise solved for each expansion.
+    /// in [`STORE_LIMIT_BYTES`] (and their second-order terms when those fit too), otherwise
+    /// solved for each expansion.
     pub fn new(
         k: SparseRef<'_>,
         m: SparseRef<'_>,
@@ -111,7 +112,9 @@ impl FreeInterface {
         // kept when they fit
         let mut wfull = Mat::<f64>::zeros(nr, nr);
         let mut wt = Mat::<f64>::zeros(nr, nr);
-        let store = 32usize.saturating_mul(n).saturating_mul(nr) <= store_limit_bytes;
+        // the first-order responses take 16 n nR bytes, the second-order terms as much again
+        let store = 16usize.saturating_mul(n).saturating_mul(nr) <= store_limit_bytes;
+        let store_second = 32usize.saturating_mul(n).saturating_mul(nr) <= store_limit_bytes;
         let mut stored = store.then(|| Stored {
             zn: Mat::zeros(n, nr),
             zt: Mat::zeros(n, nr),
@@ -148,7 +151,7 @@ impl FreeInterface {
                 .copy_from(rows.as_ref().subcols(b, b));
             c0 += b;
         }
-        if let Some(st) = stored.as_mut() {
+        if let Some(st) = stored.as_mut().filter(|_| store_second) {
             // second-order residual terms K^-1 M K^-1 (Pn^T | Pt^T)
             for (z, y) in [(&st.zn, &mut st.yn), (&st.zt, &mut st.yt)] {
                 *y = squeal_core::linalg::sparse_times(m, z.as_ref());
@@ -201,6 +204,12 @@ impl FreeInterface {
     /// Whether the static responses of the pairs are stored (else solved per expansion).
     pub fn stores_responses(&self) -> bool {
         self.stored.is_some()
+    }
+
+    /// Whether the second-order terms `K^-1 M K^-1 (Pn^T | Pt^T)` are stored too (else
+    /// solved per expansion from the first-order responses).
+    pub fn stores_second_order(&self) -> bool {
+        self.stored.as_ref().is_some_and(Stored::second_order)
     }
 
     /// Number of candidate pairs.

@@ -15,8 +15,8 @@ impl FreeInterface {
     }
 
     /// [`FreeInterface::expand`] and [`FreeInterface::correction`] together: when the
-    /// static responses are solved (not stored), the correction reuses the expansion's
-    /// `K^-1 B_A^T r` (one block solve fewer).
+    /// second-order terms are solved (not stored), the correction reuses the expansion's
+    /// `K^-1 B_A^T r` (one block solve or product fewer).
     pub fn expand_with_correction(
         &self,
         syn: &Synthesized,
@@ -36,7 +36,7 @@ impl FreeInterface {
     /// side (`n x 2 which.len()`): with `second = false`, `e = eta - Omega^-2 Q^T r` and
     /// `Y = K^-1 (Pn^T | Pt^T)` (the expansion); with `second = true`, `e = -Omega^-4 Q^T r`
     /// and `Y = K^-1 M K^-1 (Pn^T | Pt^T)` (the second-order residual term). When the
-    /// responses are solved, the first-order call also returns `K^-1 B^T r` and the
+    /// second-order terms are solved, the first-order call also returns `K^-1 B^T r` and the
     /// second-order one takes it back as `reuse`.
     fn combine(
         &self,
@@ -72,7 +72,11 @@ impl FreeInterface {
         }
         // K^-1 B^T r, or K^-1 M K^-1 B^T r
         let mut first = None;
-        let mut u = match &self.stored {
+        let mut u = match self
+            .stored
+            .as_ref()
+            .filter(|st| !second || st.second_order())
+        {
             Some(st) => {
                 let (yn, yt) = if second {
                     (&st.yn, &st.yt)
@@ -97,6 +101,10 @@ impl FreeInterface {
                         mu,
                         par(),
                     );
+                }
+                if !second && !st.second_order() {
+                    // the second-order term will be solved from it
+                    first = Some(u.clone());
                 }
                 u
             }
@@ -126,8 +134,17 @@ impl FreeInterface {
         (u, first)
     }
 
-    /// `K^-1 (Pn^T + mu Pt^T) r` for the pair loads `r` (`nR x c`, N): `n x c` (m).
+    /// `K^-1 (Pn^T + mu Pt^T) r` for the pair loads `r` (`nR x c`, N): `n x c` (m), from
+    /// the stored responses when there are, else by a block solve.
     fn static_response(&self, r: MatRef<'_, f64>, mu: f64) -> Mat<f64> {
+        if let Some(st) = &self.stored {
+            let mut x = Mat::<f64>::zeros(self.dofs(), r.ncols());
+            matmul(x.as_mut(), Accum::Replace, st.zn.as_ref(), r, 1.0, par());
+            if mu != 0.0 {
+                matmul(x.as_mut(), Accum::Add, st.zt.as_ref(), r, mu, par());
+            }
+            return x;
+        }
         let mut x = Mat::<f64>::zeros(self.dofs(), r.ncols());
         for (i, p) in self.pairs.iter().enumerate() {
             for c in 0..r.ncols() {

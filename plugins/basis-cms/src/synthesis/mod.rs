@@ -15,8 +15,9 @@
 //! `Q = B_A Phi`, whatever the number of pairs. The residual contact flexibilities
 //! `Pn G Pn^T`, `Pn G Pt^T` of the candidate pairs are computed once (one Cholesky
 //! factorization of `K`, kept, and `2 nR` solves whose pair rows alone are kept, so the
-//! memory is `O(nR^2)`, not `O(n nR)`; the whole responses `K^-1 (Pn^T | Pt^T)` and their
-//! second-order terms are stored too when they fit [`STORE_LIMIT_BYTES`]): a new contact
+//! memory is `O(nR^2)`, not `O(n nR)`; the whole responses `K^-1 (Pn^T | Pt^T)` are stored
+//! too when they fit [`STORE_LIMIT_BYTES`], and their second-order terms when those fit as
+//! well): a new contact
 //! set or mu then costs one `nA x nA` LU, one `m x m` eigen decomposition and the
 //! expansion `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r` (products with the stored
 //! responses, or block solves for the modes expanded), which satisfies `Pn_A u = 0`
@@ -72,13 +73,20 @@ pub struct FreeInterface {
     pub time_s: f64,
 }
 
-/// `K^-1 Pn^T`, `K^-1 Pt^T` and the second-order terms `K^-1 M K^-1 (Pn^T | Pt^T)`
-/// (`n x nR` each).
+/// `K^-1 Pn^T`, `K^-1 Pt^T` and, when they fit too, the second-order terms
+/// `K^-1 M K^-1 (Pn^T | Pt^T)` (`n x nR` each; `0 x 0` when not stored).
 struct Stored {
     zn: Mat<f64>,
     zt: Mat<f64>,
     yn: Mat<f64>,
     yt: Mat<f64>,
+}
+
+impl Stored {
+    /// Whether the second-order terms are stored.
+    fn second_order(&self) -> bool {
+        self.yn.nrows() > 0
+    }
 }
 
 /// Largest memory (bytes) [`FreeInterface::new`] spends on stored static responses.
