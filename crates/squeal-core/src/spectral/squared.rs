@@ -19,10 +19,10 @@ use std::sync::Arc;
 /// work and half the memory of the companion form's complex LU, on half the vector
 /// length). `K - sigma_s M` is solved by a real sparse LU ([`lu`](Self::lu)) or, for a
 /// frictional operator, by the Woodbury identity on a symmetric factor
-/// ([`low_rank`](Self::low_rank), [`woodbury`](Self::woodbury)). Eigenvalues map back as `s = sigma_s + 1/theta`,
-/// `lambda = i sqrt(s)` ([`lambda_of_s`](Self::lambda_of_s), principal root, so
-/// `Im(lambda) >= 0`); the conjugate `s` gives the mirror mode `-conj(lambda)`. Complex
-/// vectors are applied as two real columns.
+/// ([`low_rank`](Self::low_rank), [`woodbury`](Self::woodbury)). Eigenvalues map back as
+/// `s = sigma_s + 1/theta`, `lambda = i sqrt(s)` ([`lambda_of_s`](Self::lambda_of_s),
+/// principal root, so `Im(lambda) >= 0`); the conjugate `s` gives the mirror mode
+/// `-conj(lambda)`. Complex vectors are applied as two real columns.
 pub struct SquaredShift<'a> {
     qep: &'a Qep,
     sigma: f64,
@@ -82,6 +82,13 @@ impl<'a> SquaredShift<'a> {
     /// The transformation of `qep` by a Woodbury solver built for it.
     pub fn woodbury(qep: &'a Qep, solver: Woodbury<'a>) -> Result<Self> {
         undamped(qep)?;
+        if solver.shift().dim() != qep.dim() {
+            return Err(Error::Dimension {
+                context: "SquaredShift: a Woodbury solver of another size".into(),
+                expected: qep.dim(),
+                got: solver.shift().dim(),
+            });
+        }
         let sigma = solver.shift().s();
         Ok(Self::with(qep, sigma, ShiftedSolve::Woodbury(solver)))
     }
