@@ -83,25 +83,7 @@ impl FreeInterface {
                 } else {
                     (&st.zn, &st.zt)
                 };
-                let mut u = Mat::<f64>::zeros(self.dofs(), 2 * k);
-                matmul(
-                    u.as_mut(),
-                    Accum::Replace,
-                    yn.as_ref(),
-                    rfull.as_ref(),
-                    1.0,
-                    par(),
-                );
-                if mu != 0.0 {
-                    matmul(
-                        u.as_mut(),
-                        Accum::Add,
-                        yt.as_ref(),
-                        rfull.as_ref(),
-                        mu,
-                        par(),
-                    );
-                }
+                let u = combined(yn, yt, rfull.as_ref(), mu);
                 if !second && !st.second_order() {
                     // the second-order term will be solved from it
                     first = Some(u.clone());
@@ -138,12 +120,7 @@ impl FreeInterface {
     /// the stored responses when there are, else by a block solve.
     fn static_response(&self, r: MatRef<'_, f64>, mu: f64) -> Mat<f64> {
         if let Some(st) = &self.stored {
-            let mut x = Mat::<f64>::zeros(self.dofs(), r.ncols());
-            matmul(x.as_mut(), Accum::Replace, st.zn.as_ref(), r, 1.0, par());
-            if mu != 0.0 {
-                matmul(x.as_mut(), Accum::Add, st.zt.as_ref(), r, mu, par());
-            }
-            return x;
+            return combined(&st.zn, &st.zt, r, mu);
         }
         let mut x = Mat::<f64>::zeros(self.dofs(), r.ncols());
         for (i, p) in self.pairs.iter().enumerate() {
@@ -219,4 +196,14 @@ impl FreeInterface {
             c64::new(w[(i, c)], w[(i, k + c)])
         }))
     }
+}
+
+/// `(Yn + mu Yt) r` from stored responses (`n x nR` each) and pair loads `r` (`nR x c`).
+fn combined(yn: &Mat<f64>, yt: &Mat<f64>, r: MatRef<'_, f64>, mu: f64) -> Mat<f64> {
+    let mut x = Mat::<f64>::zeros(yn.nrows(), r.ncols());
+    matmul(x.as_mut(), Accum::Replace, yn.as_ref(), r, 1.0, par());
+    if mu != 0.0 {
+        matmul(x.as_mut(), Accum::Add, yt.as_ref(), r, mu, par());
+    }
+    x
 }
