@@ -9,7 +9,7 @@ use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
 };
-use faer::{Conj, MatMut, Side};
+use faer::{Conj, MatMut, Par, Side};
 
 /// A sparse supernodal `A = L L^T` (faer) in the fill-reducing ordering of
 /// [`FillOrdering::of`]: the symbolic analysis and the values of `L`.
@@ -72,15 +72,20 @@ impl SparseLlt {
     }
 
     /// `B <- A^-1 B`.
+    /// Column blocks are solved side by side ([`super::solve_by_columns`]).
     pub(crate) fn solve_in_place(&self, b: MatMut<'_, f64>) {
-        let par = faer::get_global_parallelism();
-        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(b.ncols(), par));
-        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
-            Conj::No,
-            b,
-            par,
-            MemStack::new(&mut mem),
-        );
+        super::solve_by_columns(b, &|b: MatMut<'_, f64>| {
+            let mut mem = MemBuffer::new(
+                self.symbolic
+                    .solve_in_place_scratch::<f64>(b.ncols(), Par::Seq),
+            );
+            LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+                Conj::No,
+                b,
+                Par::Seq,
+                MemStack::new(&mut mem),
+            );
+        });
     }
 }
 

@@ -156,7 +156,9 @@ impl SymmetricShift {
         let chol = &self.pencil.chol;
         let perm = PermRef::new_checked(&self.perm_fwd, &self.perm_inv, n);
         let lblt = IntranodeLbltRef::new(chol, &self.l_values, &self.subdiag, perm);
-        let mut mem = MemBuffer::new(chol.solve_in_place_scratch::<f64>(b.ncols(), self.par));
-        lblt.solve_in_place_with_conj(Conj::No, b, self.par, MemStack::new(&mut mem));
+        crate::linalg::solve_by_columns(b, &|b: MatMut<'_, f64>| {
+            let mut mem = MemBuffer::new(chol.solve_in_place_scratch::<f64>(b.ncols(), Par::Seq));
+            lblt.solve_in_place_with_conj(Conj::No, b, Par::Seq, MemStack::new(&mut mem));
+        });
     }
 }
