@@ -61,17 +61,26 @@ pub struct SceneMu<'a> {
     registry: &'a Registry,
     equilibrium: String,
     law: String,
+    law_params: Params,
     current: Option<(Vec<bool>, FrictionalOperator)>,
 }
 
 impl<'a> SceneMu<'a> {
-    /// Equilibria of `prep` by the solver `equilibrium` with contact law `law`.
-    pub fn new(prep: &'a Prepared, registry: &'a Registry, equilibrium: &str, law: &str) -> Self {
+    /// Equilibria of `prep` by the solver `equilibrium` with contact law `law` and its
+    /// parameters `law_params`.
+    pub fn new(
+        prep: &'a Prepared,
+        registry: &'a Registry,
+        equilibrium: &str,
+        law: &str,
+        law_params: &Params,
+    ) -> Self {
         Self {
             prep,
             registry,
             equilibrium: equilibrium.into(),
             law: law.into(),
+            law_params: law_params.clone(),
             current: None,
         }
     }
@@ -80,9 +89,13 @@ impl<'a> SceneMu<'a> {
 impl OperatorFamily for SceneMu<'_> {
     fn member(&mut self, mu: f64) -> Result<Member<'_>> {
         let t0 = Instant::now();
-        let eq = self
-            .prep
-            .equilibrium(self.registry, &self.equilibrium, &self.law, mu)?;
+        let eq = self.prep.equilibrium_with(
+            self.registry,
+            &self.equilibrium,
+            &self.law,
+            &self.law_params,
+            mu,
+        )?;
         let t_eq = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
         // a new operator when the contact set changed or none was built in this run (a

@@ -153,8 +153,7 @@ impl BenchArgs {
                 out: &self.out,
                 opts,
                 band,
-                equilibrium: &self.contact.equilibrium,
-                law: &self.contact.law,
+                contact: &self.contact,
                 stress: self.stress,
             },
             Some(&probe),
@@ -173,8 +172,8 @@ pub struct Args<'a> {
     pub opts: BenchOptions,
     /// `None`: the scene's `study.band_hz` (operator files: the default band).
     pub band: Option<[f64; 2]>,
-    pub equilibrium: &'a str,
-    pub law: &'a str,
+    /// Equilibrium solver, contact law and its parameters.
+    pub contact: &'a crate::opts::ContactArgs,
     pub stress: bool,
 }
 
@@ -293,8 +292,9 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
     let settings = SuiteSettings {
         mus: a.mus.to_vec(),
         opts,
-        equilibrium: a.equilibrium.into(),
-        law: a.law.into(),
+        equilibrium: a.contact.equilibrium.clone(),
+        law: a.contact.law.clone(),
+        law_params: a.contact.law_params()?,
         stress: a.stress,
     };
     let (_, summary) = run_suite(

@@ -16,15 +16,8 @@ pub struct EquilibriumArgs {
     /// Friction coefficient(s), comma separated (default: the scene's study.mu).
     #[arg(long, value_delimiter = ',')]
     mu: Vec<f64>,
-    /// Equilibrium solver plugin (`lorang`, `lcp`).
-    #[arg(long, default_value = "lcp")]
-    equilibrium: String,
-    /// Contact law plugin (`lagrange`, `penalty`).
-    #[arg(long, default_value = "lagrange")]
-    law: String,
-    /// Contact law parameters, `key=value` (e.g. `kn_n_per_m=1e10`).
-    #[arg(long = "law-opt")]
-    law_opt: Vec<String>,
+    #[command(flatten)]
+    contact: crate::opts::ContactArgs,
     /// Output directory.
     #[arg(long, default_value = "out/equilibrium")]
     out: PathBuf,
@@ -33,24 +26,17 @@ pub struct EquilibriumArgs {
 impl EquilibriumArgs {
     /// Solves, writes and prints the equilibria.
     pub fn run(&self, registry: &Registry) -> Result<()> {
-        let law_params = crate::opts::parse_params(&self.law_opt)?;
+        let law_params = self.contact.law_params()?;
         for &mu in &self.mu {
             crate::opts::check_mu("--mu", mu)?;
         }
-        registry
-            .equilibrium
-            .create(&self.equilibrium, &Params::new())
-            .context("--equilibrium")?;
-        registry
-            .contact_laws
-            .create(&self.law, &law_params)
-            .context("--law/--law-opt")?;
+        self.contact.check(registry)?;
         let reports = run(
             registry,
             &self.scene,
             &self.mu,
-            &self.equilibrium,
-            &self.law,
+            &self.contact.equilibrium,
+            &self.contact.law,
             &law_params,
             &self.out,
         )?;

@@ -215,10 +215,14 @@ pub struct ContactArgs {
     /// Contact law plugin (`lagrange`, `penalty`).
     #[arg(long, default_value = "lagrange")]
     pub law: String,
+    /// Contact law parameters, `key=value` (e.g. `kn_n_per_m=1e8` for `penalty`: the
+    /// normal stiffness per pair, N/m).
+    #[arg(long = "law-opt")]
+    pub law_opt: Vec<String>,
 }
 
 impl ContactArgs {
-    /// Checks the plugin names.
+    /// Checks the plugin names and the law's parameters.
     pub fn check(&self, registry: &squeal_core::Registry) -> Result<()> {
         registry
             .equilibrium
@@ -226,9 +230,14 @@ impl ContactArgs {
             .map_err(|e| anyhow::anyhow!("--equilibrium {}: {e}", self.equilibrium))?;
         registry
             .contact_laws
-            .create(&self.law, &squeal_core::Params::new())
-            .map_err(|e| anyhow::anyhow!("--law {}: {e}", self.law))?;
+            .create(&self.law, &self.law_params()?)
+            .map_err(|e| anyhow::anyhow!("--law {} --law-opt: {e}", self.law))?;
         Ok(())
+    }
+
+    /// The contact law's parameters (`--law-opt`).
+    pub fn law_params(&self) -> Result<squeal_core::Params> {
+        parse_params(&self.law_opt).map_err(|e| anyhow::anyhow!("--law-opt: {e}"))
     }
 }
 

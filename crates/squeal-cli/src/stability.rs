@@ -120,8 +120,7 @@ impl StabilityArgs {
             band: self.method.band.clone(),
             tol: self.method.tol,
             dvr_tol: self.method.dvr_tol,
-            equilibrium: &self.contact.equilibrium,
-            law: &self.contact.law,
+            contact: &self.contact,
         };
         let report = run(registry, &args)?;
         print(&report);
@@ -159,8 +158,7 @@ impl ExportArgs {
             registry,
             self.scene.as_deref(),
             self.mu,
-            &self.contact.equilibrium,
-            &self.contact.law,
+            &self.contact,
             &self.out,
         )
     }
@@ -180,8 +178,8 @@ pub struct Args<'a> {
     pub band: Option<String>,
     pub tol: f64,
     pub dvr_tol: f64,
-    pub equilibrium: &'a str,
-    pub law: &'a str,
+    /// Equilibrium solver, contact law and its parameters.
+    pub contact: &'a crate::opts::ContactArgs,
     pub basis: &'a str,
     pub basis_opts: &'a [String],
 }
@@ -236,7 +234,8 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
     let mu = a.mu.unwrap_or(scene.study.mu);
     let prep = Prepared::new(registry, scene, &file)?;
     let t0 = Instant::now();
-    let eq = prep.equilibrium(registry, a.equilibrium, a.law, mu)?;
+    let c = a.contact;
+    let eq = prep.equilibrium_with(registry, &c.equilibrium, &c.law, &c.law_params()?, mu)?;
     let equilibrium_time_s = t0.elapsed().as_secs_f64() + prep.condensation.time_s;
     let t1 = Instant::now();
     let op = prep.operator(&eq.eq.active)?;
@@ -412,14 +411,14 @@ pub fn export(
     registry: &Registry,
     scene: Option<&str>,
     mu: Option<f64>,
-    equilibrium: &str,
-    law: &str,
+    contact: &crate::opts::ContactArgs,
     out: &Path,
 ) -> Result<()> {
     let (scene, file) = crate::opts::load_scene(scene)?;
     let mu = mu.unwrap_or(scene.study.mu);
     let prep = Prepared::new(registry, scene, &file)?;
-    let eq = prep.equilibrium(registry, equilibrium, law, mu)?;
+    let (equilibrium, law) = (&contact.equilibrium, &contact.law);
+    let eq = prep.equilibrium_with(registry, equilibrium, law, &contact.law_params()?, mu)?;
     let op = prep.operator(&eq.eq.active)?;
     let active = eq.eq.active.iter().filter(|&&a| a).count();
     squeal_io::write_operator_dir(
@@ -430,8 +429,9 @@ pub fn export(
             mu,
             active_pairs: active,
             source: format!(
-                "squeal {} export of {file}: equilibrium `{equilibrium}` with `{law}` at mu = {mu}",
-                env!("CARGO_PKG_VERSION")
+                "squeal {} export of {file}: equilibrium `{equilibrium}` with `{law}`{} at mu = {mu}",
+                env!("CARGO_PKG_VERSION"),
+                law_opts_text(&contact.law_opt),
             ),
         },
     )?;
@@ -476,4 +476,13 @@ pub fn export(
         prep.set.len()
     );
     Ok(())
+}
+
+/// ` (k=v, ...)` for contact law parameters given, else nothing.
+fn law_opts_text(opts: &[String]) -> String {
+    if opts.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", opts.join(", "))
+    }
 }

@@ -109,8 +109,7 @@ impl MuArgs {
             basis: &self.method.basis,
             basis_opts: &self.method.basis_opt,
             band,
-            equilibrium: &self.contact.equilibrium,
-            law: &self.contact.law,
+            contact: &self.contact,
             dvr_tol: self.method.dvr_tol,
             tol: self.method.tol,
             condition: self.condition,
@@ -305,8 +304,8 @@ pub struct Args<'a> {
     pub basis_opts: &'a [String],
     /// `None`: the scene's `study.band_hz`.
     pub band: Option<[f64; 2]>,
-    pub equilibrium: &'a str,
-    pub law: &'a str,
+    /// Equilibrium solver, contact law and its parameters.
+    pub contact: &'a crate::opts::ContactArgs,
     pub dvr_tol: f64,
     pub tol: f64,
     /// Condition numbers of full-order modes above the solvers' automatic size.
@@ -333,8 +332,9 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<SweepSummary> {
     let settings = MuSweepSettings {
         basis_params: crate::opts::parse_params(a.basis_opts)?,
         eigen: a.eigen.into(),
-        equilibrium: a.equilibrium.into(),
-        law: a.law.into(),
+        equilibrium: a.contact.equilibrium.clone(),
+        law: a.contact.law.clone(),
+        law_params: a.contact.law_params()?,
         dvr_tol: a.dvr_tol,
         tol: a.tol,
         condition: a.condition,

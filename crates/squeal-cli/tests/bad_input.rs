@@ -132,6 +132,32 @@ fn options_are_checked_before_any_work() {
             &["sweep", "mu", "pin-on-disc-coarse", "--step", "1e-9"],
             &["points", "at most"],
         ),
+        // contact law parameters, shared by every command that solves an equilibrium
+        (
+            &[
+                "sweep",
+                "mu",
+                "pin-on-disc-coarse",
+                "--law",
+                "penalty",
+                "--law-opt",
+                "kn_n_per_m=-1",
+            ],
+            &["--law penalty --law-opt", "kn_n_per_m", "positive"],
+        ),
+        (
+            &[
+                "stability",
+                "pin-on-disc-coarse",
+                "--law-opt",
+                "kn_n_per_m=1e8",
+            ],
+            &["--law lagrange --law-opt", "kn_n_per_m"],
+        ),
+        (
+            &["equilibrium", "pin-on-disc-coarse", "--law-opt", "kn"],
+            &["--law-opt", "key=value"],
+        ),
         (
             &["sweep", "macro", "pin-on-disc-coarse", "--jobs", "0"],
             &["--jobs 0"],

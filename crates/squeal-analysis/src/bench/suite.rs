@@ -53,6 +53,8 @@ pub struct SuiteSettings {
     pub equilibrium: String,
     /// Contact law of a scene's cases.
     pub law: String,
+    /// The contact law's parameters (a penalty's stiffness).
+    pub law_params: squeal_core::Params,
     /// Run the stress set instead of the mu list.
     pub stress: bool,
 }
@@ -234,7 +236,7 @@ fn case_operator(
     };
     let at = || outdir::stage(format!("the operator at mu = {mu}"));
     let eq = prep
-        .equilibrium(registry, &s.equilibrium, &s.law, mu)
+        .equilibrium_with(registry, &s.equilibrium, &s.law, &s.law_params, mu)
         .map_err(at())?;
     let op = prep.operator(&eq.eq.active).map_err(at())?;
     Ok((

@@ -31,6 +31,9 @@ pub struct SweepSummary {
     pub equilibrium: String,
     /// Contact law.
     pub law: String,
+    /// The contact law's parameters, `k=v, ...` (left out when none was given).
+    #[serde(skip_serializing_if = "String::is_empty")]
+    pub law_params: String,
     /// Free DOFs of the model.
     pub dofs: usize,
     /// A mode is unstable when its DvR exceeds this.
@@ -75,7 +78,7 @@ pub fn run_into(
 ) -> Result<(SweepSummary, MuSweep), RunError> {
     let start = Instant::now();
     // the points depend on these (not on the mu list: shards and extensions share them)
-    let inputs = serde_json::json!({
+    let mut inputs = serde_json::json!({
         "scene": prep.scene.to_toml(),
         "basis": settings.basis,
         "basis_opts": format!("{:?}", settings.basis_params),
@@ -86,6 +89,10 @@ pub fn run_into(
         "tol": settings.tol,
         "squeal": env!("CARGO_PKG_VERSION"),
     });
+    // only when given, so that sweeps run before law parameters existed still resume
+    if !settings.law_params.0.is_empty() {
+        inputs["law_params"] = format!("{:?}", settings.law_params.0).into();
+    }
     let ckpt = open_checkpoint(
         out,
         "sweep mu",
@@ -119,6 +126,7 @@ pub fn run_into(
         basis: settings.basis.clone(),
         equilibrium: settings.equilibrium.clone(),
         law: settings.law.clone(),
+        law_params: law_params_text(&settings.law_params),
         dofs: prep.model.dofs.n_free(),
         dvr_tol: settings.dvr_tol,
         points: points.len(),
@@ -137,4 +145,12 @@ pub fn run_into(
     };
     outdir::write_json(&out.join("summary.json"), &summary)?;
     Ok((summary, sweep))
+}
+
+/// The contact law's parameters as `k=v, ...` (empty when none was given).
+fn law_params_text(p: &squeal_core::Params) -> String {
+    p.0.iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }

@@ -36,6 +36,8 @@ pub struct MuSweepSettings {
     pub equilibrium: String,
     /// Contact law plugin.
     pub law: String,
+    /// The contact law's parameters (a penalty's stiffness).
+    pub law_params: Params,
     /// A mode is unstable when its DvR exceeds this.
     pub dvr_tol: f64,
     /// Friction coefficients whose complex modes (with their vectors) are kept in
@@ -60,6 +62,7 @@ impl MuSweepSettings {
             tol: 1e-10,
             equilibrium: "lcp".into(),
             law: "lagrange".into(),
+            law_params: Params::new(),
             dvr_tol: 1e-6,
             keep_modes_at: Vec::new(),
             condition: false,
@@ -189,7 +192,7 @@ pub fn run_sweep(
     let t = Instant::now();
     let free = prep.free_interface_modes(registry, "arpack", 1.5 * s.band_hz[1])?;
     profile.add("free modes of tracking", t.elapsed().as_secs_f64());
-    let mut family = SceneMu::new(prep, registry, &s.equilibrium, &s.law);
+    let mut family = SceneMu::new(prep, registry, &s.equilibrium, &s.law, &s.law_params);
     let sweep = run_family_sweep(
         &mut family,
         &s.mus,

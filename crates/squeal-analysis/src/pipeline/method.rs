@@ -58,7 +58,13 @@ pub fn run_mu_sweep(
     mut solve: impl FnMut(&FrictionalOperator, f64, bool) -> Result<StepResult>,
     progress: impl FnMut(&crate::sweep::SweepPoint),
 ) -> Result<Vec<crate::sweep::SweepPoint>> {
-    let mut family = crate::family::SceneMu::new(prep, registry, equilibrium, law);
+    let mut family = crate::family::SceneMu::new(
+        prep,
+        registry,
+        equilibrium,
+        law,
+        &squeal_core::Params::new(),
+    );
     crate::family::sweep_points(
         &mut family,
         mus,
