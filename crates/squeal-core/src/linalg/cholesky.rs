@@ -71,8 +71,7 @@ impl SparseLlt {
         self.symbolic.len_val()
     }
 
-    /// `B <- A^-1 B`.
-    /// Column blocks are solved side by side ([`super::solve_by_columns`]).
+    /// `B <- A^-1 B`, column blocks side by side ([`super::solve_by_columns`]).
     pub(crate) fn solve_in_place(&self, b: MatMut<'_, f64>) {
         super::solve_by_columns(b, &|b: MatMut<'_, f64>| {
             let mut mem = MemBuffer::new(

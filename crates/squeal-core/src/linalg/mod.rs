@@ -316,8 +316,8 @@ mod tests {
 
     #[test]
     fn column_split_solves_every_column_once_for_any_thread_count() {
-        // the "solve" doubles its columns and tags them with the block's width: every
-        // column must be doubled exactly once, and no block may be empty
+        // the "solve" doubles its columns and records its block's width: every column
+        // must be doubled exactly once, and no block may be empty
         for ncols in [0usize, 1, 2, 3, 7, 64] {
             for parts in [1usize, 2, 3, 4, 9] {
                 let mut b = Mat::from_fn(5, ncols, |i, c| (i + 10 * c) as f64 + 1.0);
