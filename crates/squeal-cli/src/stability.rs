@@ -417,8 +417,9 @@ pub fn export(
     let (scene, file) = crate::opts::load_scene(scene)?;
     let mu = mu.unwrap_or(scene.study.mu);
     let prep = Prepared::new(registry, scene, &file)?;
-    let (equilibrium, law) = (&contact.equilibrium, &contact.law);
-    let eq = prep.equilibrium_with(registry, equilibrium, law, &contact.law_params()?, mu)?;
+    let (equilibrium, law, law_params) =
+        (&contact.equilibrium, &contact.law, contact.law_params()?);
+    let eq = prep.equilibrium_with(registry, equilibrium, law, &law_params, mu)?;
     let op = prep.operator(&eq.eq.active)?;
     let active = eq.eq.active.iter().filter(|&&a| a).count();
     squeal_io::write_operator_dir(
@@ -431,7 +432,11 @@ pub fn export(
             source: format!(
                 "squeal {} export of {file}: equilibrium `{equilibrium}` with `{law}`{} at mu = {mu}",
                 env!("CARGO_PKG_VERSION"),
-                law_opts_text(&contact.law_opt),
+                if law_params.0.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({law_params})")
+                },
             ),
         },
     )?;
@@ -476,13 +481,4 @@ pub fn export(
         prep.set.len()
     );
     Ok(())
-}
-
-/// ` (k=v, ...)` for contact law parameters given, else nothing.
-fn law_opts_text(opts: &[String]) -> String {
-    if opts.is_empty() {
-        String::new()
-    } else {
-        format!(" ({})", opts.join(", "))
-    }
 }

@@ -43,6 +43,19 @@ impl std::fmt::Display for ParamValue {
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Params(pub BTreeMap<String, ParamValue>, ReadLog);
 
+impl std::fmt::Display for Params {
+    /// The parameters as a user writes them, in key order: `k=v, k=v` (empty when none).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for (i, (k, v)) in self.0.iter().enumerate() {
+            if i > 0 {
+                write!(f, ", ")?;
+            }
+            write!(f, "{k}={v}")?;
+        }
+        Ok(())
+    }
+}
+
 /// The keys asked of a tracked [`Params`] (shared by its clones); equal to any other log,
 /// so that parameters compare by their values only.
 #[derive(Debug, Clone, Default)]

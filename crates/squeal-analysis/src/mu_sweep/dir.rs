@@ -91,7 +91,7 @@ pub fn run_into(
     });
     // only when given, so that sweeps run before law parameters existed still resume
     if !settings.law_params.0.is_empty() {
-        inputs["law_params"] = format!("{:?}", settings.law_params.0).into();
+        inputs["law_params"] = settings.law_params.to_string().into();
     }
     let ckpt = open_checkpoint(
         out,
@@ -126,7 +126,7 @@ pub fn run_into(
         basis: settings.basis.clone(),
         equilibrium: settings.equilibrium.clone(),
         law: settings.law.clone(),
-        law_params: law_params_text(&settings.law_params),
+        law_params: settings.law_params.to_string(),
         dofs: prep.model.dofs.n_free(),
         dvr_tol: settings.dvr_tol,
         points: points.len(),
@@ -145,12 +145,4 @@ pub fn run_into(
     };
     outdir::write_json(&out.join("summary.json"), &summary)?;
     Ok((summary, sweep))
-}
-
-/// The contact law's parameters as `k=v, ...` (empty when none was given).
-fn law_params_text(p: &squeal_core::Params) -> String {
-    p.0.iter()
-        .map(|(k, v)| format!("{k}={v}"))
-        .collect::<Vec<_>>()
-        .join(", ")
 }
