@@ -6,7 +6,7 @@
 use squeal::analysis::pipeline::{damped_operator, Method, Prepared};
 use squeal::contact::ContactSet;
 use squeal::core::operator::ComplexModes;
-use squeal::core::{EigenParams, FrictionalOperator, Params, Registry};
+use squeal::core::{EigenParams, FrictionalOperator, ParamValue, Params, Registry};
 use squeal::scene::{Damping, Scene, Zone};
 use squeal_basis_cms::FreeInterface;
 
@@ -252,4 +252,69 @@ fn a_prepared_model_computes_its_free_modes_and_synthesis_once() {
     for (x, y) in sa.iter().zip(&sf) {
         assert!((x - y).abs() <= 1e-9 * y.abs().max(1.0), "{x} vs {y}");
     }
+}
+
+#[test]
+fn cms_projected_on_the_pairs_matches_the_explicit_projection() {
+    let (reg, prep) = setup();
+    let method = |projection: &str| {
+        let p = Params::new().with("projection", ParamValue::Str(projection.into()));
+        let mut m = Method::new(&reg, "cms", &p, "dense", "arpack", params()).unwrap();
+        m.prepare_stage(&prep.model, &prep.set).unwrap();
+        m
+    };
+    let (mut explicit, mut on_pairs) = (method("full"), method("pairs"));
+    let mut compared = 0;
+    for mu in [0.0, 0.3, 0.7, 1.0] {
+        let eq = prep.equilibrium(&reg, "lcp", "lagrange", mu).unwrap();
+        let op = prep.operator(&eq.eq.active).unwrap();
+        let (a, na, _) = explicit.solve(&op, mu, true).unwrap();
+        let (b, nb, _) = on_pairs.solve(&op, mu, true).unwrap();
+        let reference = full(&reg, &op, mu);
+        let (df, ddvr, eta) = errors(&reference, &b);
+        let (dfa, ddvra, _) = errors(&reference, &a);
+        println!(
+            "mu {mu}: explicit {na} vectors df/f {dfa:.1e} dDvR {ddvra:.1e}; on the pairs \
+             {nb} vectors df/f {df:.1e} dDvR {ddvr:.1e}, worst backward error {eta:.1e}"
+        );
+        // the same subspace: the same Ritz values, to far below the basis's own error
+        assert_eq!(
+            a.len(),
+            b.len(),
+            "mu {mu}: {:?} vs {:?}",
+            a.freq_hz,
+            b.freq_hz
+        );
+        for i in 0..a.len() {
+            let (j, d) = (0..b.len())
+                .map(|j| (j, (b.lambda[j] - a.lambda[i]).norm()))
+                .min_by(|x, y| x.1.total_cmp(&y.1))
+                .unwrap();
+            assert!(
+                d <= 1e-7 * a.lambda[i].norm(),
+                "mu {mu}: {} vs {}",
+                a.lambda[i],
+                b.lambda[j]
+            );
+            compared += 1;
+        }
+        assert!(df <= 2e-4 && ddvr <= 1e-4 && eta <= 1e-6, "mu {mu}");
+        assert!(b
+            .info
+            .notes
+            .iter()
+            .any(|n| n.contains("projected on the pairs")));
+    }
+    assert!(compared > 10);
+}
+
+#[test]
+fn cms_projection_option_is_checked() {
+    let reg = squeal::registry();
+    let p = Params::new().with("projection", ParamValue::Str("sideways".into()));
+    let err = Method::new(&reg, "cms", &p, "dense", "arpack", params())
+        .err()
+        .expect("an unknown projection is refused")
+        .to_string();
+    assert!(err.contains("projection") && err.contains("pairs"), "{err}");
 }

@@ -40,8 +40,8 @@ pub mod registry;
 pub mod spectral;
 
 pub use contact::{
-    build_basis, Basis, BasisRequest, ContactLaw, EquilibriumSolver, FreeModel, ModelStage,
-    PairDofs, ReductionBasis,
+    build_basis, Basis, BasisRequest, ContactLaw, EquilibriumSolver, FreeModel, ImplicitColumns,
+    ModelStage, PairDofs, ReductionBasis,
 };
 pub use eigen::{
     solve_symmetric_band, EigenParams, EigenSolver, KernelOutput, SymmetricKernel, SymmetricProblem,

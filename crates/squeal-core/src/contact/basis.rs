@@ -2,18 +2,35 @@
 //! ([`BasisRequest`]) and the basis it builds ([`Basis`]).
 
 use super::{FreeModel, ModelStage};
+use crate::c64;
 use crate::eigen::{EigenParams, EigenSolver};
 use crate::operator::FrictionalOperator;
 use crate::{Error, Result};
-use faer::Mat;
+use faer::{Mat, MatRef};
 use std::any::Any;
+use std::sync::Arc;
+
+/// Basis columns kept by their action rather than stored: a basis whose projection was
+/// assembled without forming its `n_c x m` columns (e.g. from data on the contact pairs)
+/// expands the reduced vectors it is asked for, `V q`, on demand.
+pub trait ImplicitColumns: Send + Sync + std::fmt::Debug {
+    /// Rows of the columns (the constrained DOFs `n_c`).
+    fn nrows(&self) -> usize;
+    /// Number of columns `m`.
+    fn ncols(&self) -> usize;
+    /// `V q` for the reduced vectors `q` (`m x k`): `n_c x k`.
+    fn apply(&self, q: MatRef<'_, c64>) -> Result<Mat<c64>>;
+}
 
 /// A real reduction basis on the constrained space, `M_c`-orthonormal
 /// (`V^T M_c V = I` to round-off), with how it was built.
 #[derive(Debug, Clone)]
 pub struct Basis {
-    /// Columns of the basis (`n_c x m`).
+    /// Columns of the basis (`n_c x m`); `0 x 0` when they are [`Basis::implicit`].
     pub v: Mat<f64>,
+    /// The columns by their action, when they are not stored (then [`Basis::projected`]
+    /// is set too: nothing else could project the operator on them).
+    pub implicit: Option<Arc<dyn ImplicitColumns>>,
     /// Wall time to build it (s), set by [`build_basis`].
     pub time_s: f64,
     /// Candidate vectors removed by the rank cut (and the optional SVD compression).
@@ -39,6 +56,7 @@ impl Basis {
     pub fn new(v: Mat<f64>) -> Self {
         Self {
             v,
+            implicit: None,
             time_s: 0.0,
             dropped: 0,
             iterations: 0,
@@ -49,14 +67,35 @@ impl Basis {
         }
     }
 
+    /// A basis of implicit columns with the operator `projected` on them.
+    pub fn implicit(columns: Arc<dyn ImplicitColumns>, projected: FrictionalOperator) -> Self {
+        let mut basis = Self::new(Mat::zeros(0, 0));
+        basis.implicit = Some(columns);
+        basis.projected = Some(projected);
+        basis
+    }
+
     /// Number of columns `m`.
     pub fn len(&self) -> usize {
-        self.v.ncols()
+        self.implicit.as_ref().map_or(self.v.ncols(), |c| c.ncols())
+    }
+
+    /// Rows of the columns (the constrained DOFs).
+    pub fn nrows(&self) -> usize {
+        self.implicit.as_ref().map_or(self.v.nrows(), |c| c.nrows())
     }
 
     /// Whether the basis has no column.
     pub fn is_empty(&self) -> bool {
-        self.v.ncols() == 0
+        self.len() == 0
+    }
+
+    /// The full vectors `V q` of reduced vectors `q` (`m x k`).
+    pub fn expand(&self, q: MatRef<'_, c64>) -> Result<Mat<c64>> {
+        match &self.implicit {
+            Some(c) => c.apply(q),
+            None => Ok(crate::reduction::expand(self.v.as_ref(), q)),
+        }
     }
 }
 
@@ -136,12 +175,12 @@ pub fn build_basis(basis: &dyn ReductionBasis, request: &BasisRequest<'_>) -> Re
     }
     let start = std::time::Instant::now();
     let mut built = basis.build(request)?;
-    if built.is_empty() || built.v.nrows() != request.op.dim() {
+    if built.is_empty() || built.nrows() != request.op.dim() {
         return Err(Error::Invalid(format!(
             "basis `{}` returned {} x {} columns for an operator of {} DOFs",
             basis.name(),
-            built.v.nrows(),
-            built.v.ncols(),
+            built.nrows(),
+            built.len(),
             request.op.dim()
         )));
     }

@@ -58,7 +58,7 @@ pub use orthonormal::{
     m_orthonormal_extend, m_orthonormal_extend_imaged, m_orthonormality_error, m_orthonormalize,
     m_svd_compress, DEFAULT_RANK_TOL,
 };
-pub use project::{expand, project};
+pub use project::{dense_to_sparse, expand, project};
 pub use solve::{solve_reduced, ReducedOperator, ReducedSolve};
 pub use statics::{energy_residuals, StaticSolver};
 

@@ -9,8 +9,9 @@ use faer::linalg::matmul::matmul;
 use faer::sparse::Triplet;
 use faer::{Accum, Mat, MatRef};
 
-/// A dense matrix stored as a sparse one (its nonzero entries).
-pub(super) fn dense_to_sparse(a: MatRef<'_, f64>) -> Result<SparseMat> {
+/// A dense matrix stored as a sparse one (its nonzero entries): how a reduced operator
+/// assembled by other means is handed over as a [`FrictionalOperator`].
+pub fn dense_to_sparse(a: MatRef<'_, f64>) -> Result<SparseMat> {
     let mut t = Vec::with_capacity(a.nrows() * a.ncols());
     for j in 0..a.ncols() {
         for i in 0..a.nrows() {

@@ -1,7 +1,7 @@
 //! The reduced solve: a basis with the operator projected on it ([`ReducedOperator`]),
 //! solved at any mu, its modes expanded with backward errors on the full operator.
 
-use super::{expand, project};
+use super::project;
 use crate::contact::Basis;
 use crate::eigen::{EigenParams, EigenSolver};
 use crate::operator::{ComplexModes, FrictionalOperator};
@@ -47,9 +47,14 @@ impl ReducedOperator {
     /// Projects `op` on `basis` (or takes the projection the basis carries).
     pub fn new(op: &FrictionalOperator, mut basis: Basis) -> Result<Self> {
         let start = Instant::now();
-        let m = basis.v.ncols();
+        let m = basis.len();
         let reduced = match basis.projected.take() {
             Some(p) if p.dim() == m => p,
+            _ if basis.implicit.is_some() => {
+                return Err(Error::Invalid(
+                    "a basis of implicit columns without its projected operator".into(),
+                ))
+            }
             _ => project(op, basis.v.as_ref())?,
         };
         Ok(Self {
@@ -69,11 +74,11 @@ impl ReducedOperator {
         eigen: &dyn EigenSolver,
         params: &EigenParams,
     ) -> Result<ReducedSolve> {
-        if op.dim() != self.basis.v.nrows() {
+        if op.dim() != self.basis.nrows() {
             return Err(Error::Dimension {
                 context: "reduced solve: the basis was built for another operator".into(),
                 expected: op.dim(),
-                got: self.basis.v.nrows(),
+                got: self.basis.nrows(),
             });
         }
         if let Some(b) = self.basis.mu {
@@ -98,7 +103,7 @@ impl ReducedOperator {
             red.vectors[(i, kept[j])]
         });
         let lambda: Vec<c64> = kept.iter().map(|&i| red.lambda[i]).collect();
-        let u = expand(self.basis.v.as_ref(), q.as_ref());
+        let u = self.basis.expand(q.as_ref())?;
         let mut info = red.info.clone();
         info.notes.push(format!(
             "reduced on a basis of {} vectors ({} dropped by the rank cut, {} iterations); \
@@ -111,7 +116,7 @@ impl ReducedOperator {
         let mut modes = match &red.left_vectors {
             Some(p) => {
                 let pk = Mat::from_fn(p.nrows(), kept.len(), |i, j| p[(i, kept[j])]);
-                let y = expand(self.basis.v.as_ref(), pk.as_ref());
+                let y = self.basis.expand(pk.as_ref())?;
                 finish_operator_modes_with_left(
                     op,
                     mu,

@@ -1,6 +1,7 @@
 //! Construction of a [`FreeInterface`] (modes, static contact responses, residual
 //! contact flexibilities) and what it tells about itself.
 
+use super::pairs::PairMoments;
 use super::{add_pair_load, par, FreeInterface, PairDofs, Stored, STORE_LIMIT_BYTES};
 use squeal_core::faer::linalg::matmul::matmul;
 use squeal_core::faer::{Accum, Mat, MatRef};
@@ -50,7 +51,7 @@ impl FreeInterface {
         modes: &RealModes,
         store_limit_bytes: usize,
     ) -> Result<Self> {
-        Self::build(k, m, pairs, modes, None, store_limit_bytes)
+        Self::build(k, m, pairs, modes, None, store_limit_bytes, false)
     }
 
     /// [`FreeInterface::new`] with the Cholesky factor of the same `K` already computed
@@ -65,7 +66,24 @@ impl FreeInterface {
         modes: &RealModes,
         factor: Arc<Cholesky>,
     ) -> Result<Self> {
-        Self::build(k, m, pairs, modes, Some(factor), STORE_LIMIT_BYTES)
+        Self::build(k, m, pairs, modes, Some(factor), STORE_LIMIT_BYTES, false)
+    }
+
+    /// [`FreeInterface::new`] (on the given factor of `K` when there is one) with the
+    /// moments of the static responses on the pairs as well, so that every contact set's
+    /// operator can be projected on the pairs alone ([`FreeInterface::project_on_pairs`]):
+    /// three more block solves per block of pairs, and `160 nR^2` bytes (an error beyond
+    /// [`PAIR_MOMENTS_LIMIT_BYTES`]).
+    ///
+    /// [`PAIR_MOMENTS_LIMIT_BYTES`]: super::PAIR_MOMENTS_LIMIT_BYTES
+    pub fn with_pair_moments(
+        k: SparseRef<'_>,
+        m: SparseRef<'_>,
+        pairs: &[PairDofs],
+        modes: &RealModes,
+        factor: Option<Arc<Cholesky>>,
+    ) -> Result<Self> {
+        Self::build(k, m, pairs, modes, factor, STORE_LIMIT_BYTES, true)
     }
 
     fn build(
@@ -75,12 +93,17 @@ impl FreeInterface {
         modes: &RealModes,
         factor: Option<Arc<Cholesky>>,
         store_limit_bytes: usize,
+        with_moments: bool,
     ) -> Result<Self> {
         let start = Instant::now();
         let n = k.nrows();
         let nr = pairs.len();
         let nm = modes.omega2.len();
         check_inputs(k, m, pairs, modes)?;
+        let mut moments = match with_moments {
+            true => Some(PairMoments::zeros(k, m, pairs, modes)?),
+            false => None,
+        };
         let factor = match factor {
             Some(f) if f.dim() == n => f,
             Some(f) => {
@@ -131,6 +154,9 @@ impl FreeInterface {
                 add_pair_load(&mut x, p, b + j, 0.0, 1.0);
             }
             factor.solve_in_place(x.as_mut());
+            if let Some(mo) = moments.as_mut() {
+                mo.add_block(&factor, m, pairs, &phi, c0, b, &x);
+            }
             if let Some(st) = stored.as_mut() {
                 st.zn
                     .as_mut()
@@ -150,6 +176,9 @@ impl FreeInterface {
                 .subcols_mut(c0, b)
                 .copy_from(rows.as_ref().subcols(b, b));
             c0 += b;
+        }
+        if let Some(mo) = moments.as_mut() {
+            mo.finish();
         }
         if let Some(st) = stored.as_mut().filter(|_| store_second) {
             // second-order residual terms K^-1 M K^-1 (Pn^T | Pt^T)
@@ -181,16 +210,17 @@ impl FreeInterface {
             / (2.0 * std::f64::consts::PI);
         Ok(Self {
             pairs: pairs.to_vec(),
-            phi,
+            phi: Arc::new(phi),
             omega2: modes.omega2.clone(),
             factor,
             stored,
-            m: SparseMat::new(
+            m: Arc::new(SparseMat::new(
                 m.symbolic()
                     .to_owned()
                     .map_err(|e| Error::Invalid(format!("copy of M: {e:?}")))?,
                 m.val().to_vec(),
-            ),
+            )),
+            moments,
             wfull,
             wn,
             wt,
@@ -210,6 +240,12 @@ impl FreeInterface {
     /// solved per expansion from the first-order responses).
     pub fn stores_second_order(&self) -> bool {
         self.stored.as_ref().is_some_and(Stored::second_order)
+    }
+
+    /// Whether the moments of the static responses on the pairs are built (every contact
+    /// set then projected on the pairs alone).
+    pub fn has_pair_moments(&self) -> bool {
+        self.moments.is_some()
     }
 
     /// Number of candidate pairs.

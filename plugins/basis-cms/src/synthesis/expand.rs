@@ -96,7 +96,8 @@ impl FreeInterface {
                     None => self.static_response(rfull.as_ref(), mu),
                 };
                 if second {
-                    let mut u = squeal_core::linalg::sparse_times(self.m.as_ref(), z.as_ref());
+                    let mut u =
+                        squeal_core::linalg::sparse_times(self.m.as_ref().as_ref(), z.as_ref());
                     self.factor.solve_in_place(u.as_mut());
                     u
                 } else {
@@ -108,7 +109,7 @@ impl FreeInterface {
         matmul(
             u.as_mut(),
             Accum::Add,
-            self.phi.as_ref(),
+            self.phi.as_ref().as_ref(),
             coef.as_ref(),
             1.0,
             par(),

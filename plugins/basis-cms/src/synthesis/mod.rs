@@ -37,10 +37,12 @@ use std::sync::Arc;
 
 mod construct;
 mod expand;
+mod pairs;
 mod synthesize;
 #[cfg(test)]
 mod tests;
 
+pub use pairs::{PairColumns, PairsProjection, PAIR_MOMENTS_LIMIT_BYTES};
 pub use squeal_core::PairDofs;
 pub use synthesize::Synthesized;
 
@@ -48,7 +50,7 @@ pub use synthesize::Synthesized;
 /// docs): modes, static contact responses and residual contact flexibilities.
 pub struct FreeInterface {
     pairs: Vec<PairDofs>,
-    phi: Mat<f64>,
+    phi: Arc<Mat<f64>>,
     omega2: Vec<f64>,
     /// Cholesky factor of `K`: the static responses `K^-1 (Pn^T | Pt^T) r` of the
     /// expansion, solved for the modes expanded (when they are not stored).
@@ -57,7 +59,10 @@ pub struct FreeInterface {
     /// limit: faster expansions, `4 n nR` values.
     stored: Option<Stored>,
     /// `M`, for the second-order residual terms `K^-1 M K^-1 (.)`.
-    m: SparseMat,
+    m: Arc<SparseMat>,
+    /// The moments of the static responses on the pairs, when built: every contact set's
+    /// projection is then assembled on the pairs ([`FreeInterface::project_on_pairs`]).
+    moments: Option<pairs::PairMoments>,
     /// Full static `Pn K^-1 Pn^T` (`nR x nR`, m/N).
     wfull: Mat<f64>,
     /// Residual `Pn G Pn^T` (`nR x nR`, m/N).

@@ -268,3 +268,36 @@ fn solved_and_stored_responses_expand_alike() {
         }
     }
 }
+
+#[test]
+fn pairs_projection_is_the_projection_of_its_columns() {
+    let (k, m) = model();
+    let fi = FreeInterface::with_pair_moments(
+        sparse(&k).as_ref(),
+        mass(&m).as_ref(),
+        &pairs(),
+        &modes(&k, &m, 12),
+        None,
+    )
+    .unwrap();
+    assert!(fi.has_pair_moments());
+    let md = Mat::from_fn(N, N, |i, j| if i == j { m[i] } else { 0.0 });
+    let active = [1, 3];
+    for second_order in [false, true] {
+        let syn = fi.synthesize(&active, 0.5).unwrap();
+        let which: Vec<usize> = (0..syn.s.len()).filter(|&c| syn.s[c].im >= 0.0).collect();
+        let t: Vec<usize> = (0..N).collect();
+        let p = fi
+            .project_on_pairs(&syn, &which, second_order, &t, N)
+            .unwrap();
+        let cols = squeal_core::ImplicitColumns::ncols(&p.columns);
+        let u = p
+            .columns
+            .unconstrained(Mat::<f64>::identity(cols, cols).as_ref());
+        for (name, x, red) in [("K", &k, &p.reduced.kc), ("M", &md, &p.reduced.mc)] {
+            let g = u.transpose() * x * &u;
+            let err = (&g - red.to_dense()).norm_max() / g.norm_max();
+            assert!(err < 1e-9, "second order {second_order}: {name}: {err:e}");
+        }
+    }
+}
