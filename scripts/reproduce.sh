@@ -35,11 +35,13 @@ case "$name" in
   macro)
     [ -d out/macro-centred ] && resume=(--resume)
     $squeal sweep macro pin-on-disc --x0 centred --y0 centred --a 0.004:0.02:0.002 \
-      --b 0.0142 --mu 0.36,0.43 --basis cms --jobs 2 --out out/macro-centred "${resume[@]}" "$@"
+      --b 0.0142 --mu 0.36,0.43 --basis cms --basis-opt projection=pairs --jobs 2 \
+      --out out/macro-centred "${resume[@]}" "$@"
     resume=()
     [ -d out/macro-grid ] && resume=(--resume)
     $squeal sweep macro pin-on-disc --x0 0:0.016:0.004 --y0 centred --a 0.004:0.02:0.004 \
-      --b 0.004:0.02:0.004 --mu 0.36,0.43 --basis cms --jobs 2 --out out/macro-grid \
+      --b 0.004:0.02:0.004 --mu 0.36,0.43 --basis cms --basis-opt projection=pairs --jobs 2 \
+      --out out/macro-grid \
       "${resume[@]}" "$@" ;;
   meso-c2)
     [ -d out/meso-c2 ] && resume=(--resume)
