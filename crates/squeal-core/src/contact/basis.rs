@@ -94,7 +94,7 @@ impl Basis {
     pub fn expand(&self, q: MatRef<'_, c64>) -> Result<Mat<c64>> {
         match &self.implicit {
             Some(c) => c.apply(q),
-            None => Ok(crate::reduction::expand(self.v.as_ref(), q)),
+            None => Ok(crate::linalg::expand(self.v.as_ref(), q)),
         }
     }
 }

@@ -310,6 +310,33 @@ pub fn check_square_finite(a: SparseRef<'_>, n: usize, what: &str) -> Result<()>
     Ok(())
 }
 
+/// Expands reduced vectors: `u = V q` (`V` real `n x m`, `q` complex `m x k`).
+pub fn expand(v: MatRef<'_, f64>, q: MatRef<'_, crate::c64>) -> Mat<crate::c64> {
+    // One real product V [Re Q, Im Q] (BLAS-3, parallel), then recombined.
+    let k = q.ncols();
+    let parts = Mat::from_fn(q.nrows(), 2 * k, |i, j| {
+        if j < k {
+            q[(i, j)].re
+        } else {
+            q[(i, j - k)].im
+        }
+    });
+    let mut u = Mat::<f64>::zeros(v.nrows(), 2 * k);
+    if k > 0 && v.ncols() > 0 {
+        faer::linalg::matmul::matmul(
+            u.as_mut(),
+            faer::Accum::Replace,
+            v,
+            parts.as_ref(),
+            1.0,
+            faer::get_global_parallelism(),
+        );
+    }
+    Mat::from_fn(v.nrows(), k, |i, j| {
+        crate::c64::new(u[(i, j)], u[(i, j + k)])
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

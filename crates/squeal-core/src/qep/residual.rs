@@ -137,50 +137,71 @@ pub(super) fn backward_errors(
     u: MatRef<'_, c64>,
 ) -> Vec<f64> {
     let (n, k) = (u.nrows(), u.ncols());
-    if k == 0 {
-        return Vec::new();
-    }
-    // Columns [lo, hi) of the vectors, as interleaved (re, im) rows of width 2 (hi - lo).
-    let block = |lo: usize, hi: usize| -> Vec<f64> {
+    split_columns(k, |lo, hi| {
         let w = hi - lo;
-        let x: Vec<f64> = (0..n)
-            .flat_map(|i| (lo..hi).flat_map(move |j| [u[(i, j)].re, u[(i, j)].im]))
-            .collect();
-        let times = |terms: &[(SparseRef<'_>, f64)]| -> Vec<f64> {
-            let mut y = vec![0.0; n * 2 * w];
-            for (a, s) in terms {
-                for c in 0..a.ncols() {
-                    let xc = &x[c * 2 * w..(c + 1) * 2 * w];
-                    for (&i, &v) in a.row_idx_of_col_raw(c).iter().zip(a.val_of_col(c)) {
-                        let yi = &mut y[i * 2 * w..(i + 1) * 2 * w];
-                        let v = s * v;
-                        yi.iter_mut().zip(xc).for_each(|(y, x)| *y += v * x);
-                    }
-                }
-            }
-            y
-        };
-        let (mx, kx) = (times(&qep.m), times(&qep.k));
-        let cx = (!qep.c.is_empty()).then(|| times(&qep.c));
-        let at = |y: &[f64], i: usize, j: usize| {
-            c64::new(y[i * 2 * w + 2 * j], y[i * 2 * w + 2 * j + 1])
-        };
+        let x = interleave(u, lo, hi);
+        let (mx, kx) = (terms_times(n, &qep.m, &x, w), terms_times(n, &qep.k, &x, w));
+        let cx = (!qep.c.is_empty()).then(|| terms_times(n, &qep.c, &x, w));
         let (mut num, mut un) = (vec![0.0; w], vec![0.0; w]);
         for i in 0..n {
             for j in 0..w {
                 let l = lambda[lo + j];
-                let mut t = at(&mx, i, j) * l;
+                let mut t = at(&mx, w, i, j) * l;
                 if let Some(cx) = &cx {
-                    t += at(cx, i, j);
+                    t += at(cx, w, i, j);
                 }
-                num[j] += (t * l + at(&kx, i, j)).norm_sqr();
-                un[j] += at(&x, i, j).norm_sqr();
+                num[j] += (t * l + at(&kx, w, i, j)).norm_sqr();
+                un[j] += at(&x, w, i, j).norm_sqr();
             }
         }
         (0..w)
             .map(|j| norms.relative(lambda[lo + j], num[j].sqrt(), un[j].sqrt()))
             .collect()
-    };
+    })
+}
+
+/// Columns `[lo, hi)` of `u` as interleaved `(re, im)` rows of width `2 (hi - lo)`.
+pub(super) fn interleave(u: MatRef<'_, c64>, lo: usize, hi: usize) -> Vec<f64> {
+    (0..u.nrows())
+        .flat_map(|i| (lo..hi).flat_map(move |j| [u[(i, j)].re, u[(i, j)].im]))
+        .collect()
+}
+
+/// Entry `(i, j)` of `w` interleaved complex columns.
+pub(super) fn at(y: &[f64], w: usize, i: usize, j: usize) -> c64 {
+    c64::new(y[i * 2 * w + 2 * j], y[i * 2 * w + 2 * j + 1])
+}
+
+/// `sum s_i A_i X` for `w` interleaved complex columns `x`: one pass over each matrix
+/// for all columns, every nonzero updating a contiguous row.
+pub(super) fn terms_times(
+    n: usize,
+    terms: &[(SparseRef<'_>, f64)],
+    x: &[f64],
+    w: usize,
+) -> Vec<f64> {
+    let mut y = vec![0.0; n * 2 * w];
+    for (a, s) in terms {
+        for c in 0..a.ncols() {
+            let xc = &x[c * 2 * w..(c + 1) * 2 * w];
+            for (&i, &v) in a.row_idx_of_col_raw(c).iter().zip(a.val_of_col(c)) {
+                let yi = &mut y[i * 2 * w..(i + 1) * 2 * w];
+                let v = s * v;
+                yi.iter_mut().zip(xc).for_each(|(y, x)| *y += v * x);
+            }
+        }
+    }
+    y
+}
+
+/// `block(lo, hi)` over the `k` columns split between two threads, results in order.
+pub(super) fn split_columns<T: Send>(
+    k: usize,
+    block: impl Fn(usize, usize) -> Vec<T> + Sync,
+) -> Vec<T> {
+    if k == 0 {
+        return Vec::new();
+    }
     let mid = k / 2;
     if mid == 0 {
         return block(0, k);

@@ -51,6 +51,7 @@ mod statics;
 #[cfg(test)]
 mod tests;
 
+pub use crate::linalg::expand;
 pub use candidates::{coupled_real_modes, friction_load_directions};
 pub use growing::GrowingBasis;
 pub use mac::mac_real_complex;
@@ -58,7 +59,7 @@ pub use orthonormal::{
     m_orthonormal_extend, m_orthonormal_extend_imaged, m_orthonormality_error, m_orthonormalize,
     m_svd_compress, DEFAULT_RANK_TOL,
 };
-pub use project::{dense_to_sparse, expand, project};
+pub use project::{dense_to_sparse, project};
 pub use solve::{solve_reduced, ReducedOperator, ReducedSolve};
 pub use statics::{energy_residuals, StaticSolver};
 

@@ -1,13 +1,12 @@
 //! Projection of every part of a frictional operator on a basis (`V^T X V`,
 //! [`project`]) and expansion of reduced vectors (`u = V q`, [`expand`]).
 
-use super::{par, tmul};
+use super::tmul;
 use crate::linalg::sparse_transpose_times;
 use crate::operator::FrictionalOperator;
-use crate::{c64, Error, Result, SparseMat, SparseRef};
-use faer::linalg::matmul::matmul;
+use crate::{Error, Result, SparseMat, SparseRef};
 use faer::sparse::Triplet;
-use faer::{Accum, Mat, MatRef};
+use faer::{Mat, MatRef};
 
 /// A dense matrix stored as a sparse one (its nonzero entries): how a reduced operator
 /// assembled by other means is handed over as a [`FrictionalOperator`].
@@ -122,22 +121,4 @@ pub(super) fn project_loads(
         }
         None => None,
     })
-}
-
-/// Expands reduced vectors: `u = V q` (`V` real `n x m`, `q` complex `m x k`).
-pub fn expand(v: MatRef<'_, f64>, q: MatRef<'_, c64>) -> Mat<c64> {
-    // One real product V [Re Q, Im Q] (BLAS-3, parallel), then recombined.
-    let k = q.ncols();
-    let parts = Mat::from_fn(q.nrows(), 2 * k, |i, j| {
-        if j < k {
-            q[(i, j)].re
-        } else {
-            q[(i, j - k)].im
-        }
-    });
-    let mut u = Mat::<f64>::zeros(v.nrows(), 2 * k);
-    if k > 0 && v.ncols() > 0 {
-        matmul(u.as_mut(), Accum::Replace, v, parts.as_ref(), 1.0, par());
-    }
-    Mat::from_fn(v.nrows(), k, |i, j| c64::new(u[(i, j)], u[(i, j + k)]))
 }
