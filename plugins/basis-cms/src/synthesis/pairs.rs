@@ -49,7 +49,7 @@ use squeal_core::{
 use std::sync::Arc;
 
 /// Largest memory (bytes) the moments on the pairs may take (`288 nR^2` bytes).
-pub const PAIR_MOMENTS_LIMIT_BYTES: usize = 10 << 30;
+pub const PAIR_MOMENTS_LIMIT_BYTES: usize = 4 << 30;
 
 /// Relative cut on the eigenvalues of the scaled Gram matrix (squared `M`-norms): a
 /// direction whose `M`-norm is below `1e-6` of the largest is dropped, since the Gram
@@ -179,28 +179,24 @@ impl PairMoments {
             );
             c
         };
-        let solve_m = |x: &Mat<f64>| {
-            let mut y = sym_times(m, x.as_ref());
-            factor.solve_in_place(y.as_mut());
-            y
+        // E_s M x and K^-1 M x
+        let step = |x: &Mat<f64>| {
+            let mut mx = sym_times(m, x.as_ref());
+            let es = Mat::from_fn(nr, 2 * b, |i, j| mx[(pairs[i].pin[2], j)]);
+            factor.solve_in_place(mx.as_mut());
+            (es, mx)
         };
         let mut zr = z.clone();
         let c_0 = deflate(&mut zr);
         let lz = l_rows(pairs, zr.as_ref());
-        let mz = sym_times(m, zr.as_ref());
-        let esm0 = Mat::from_fn(nr, 2 * b, |i, j| mz[(pairs[i].pin[2], j)]);
-        let mut yr = mz;
-        factor.solve_in_place(yr.as_mut());
+        let (esm0, mut yr) = step(&zr);
         let ly_raw = l_rows(pairs, yr.as_ref());
         let c_1 = deflate(&mut yr);
         let ly = l_rows(pairs, yr.as_ref());
-        let my = sym_times(m, yr.as_ref());
-        let esm1 = Mat::from_fn(nr, 2 * b, |i, j| my[(pairs[i].pin[2], j)]);
-        let mut x3 = my;
-        factor.solve_in_place(x3.as_mut());
+        let (esm1, mut x3) = step(&yr);
         let lx3 = l_rows(pairs, x3.as_ref());
         deflate(&mut x3);
-        let lx4 = l_rows(pairs, solve_m(&x3).as_ref());
+        let lx4 = l_rows(pairs, step(&x3).1.as_ref());
         // D_0 = Phi^T L - (Phi^T K Phi) C_0 (the columns' own rows of P = L^T Phi),
         // D_1 = Phi^T M Z - (Phi^T K Phi) C_1
         let p_cols = Mat::from_fn(phi.ncols(), 2 * b, |i, j| {
