@@ -34,7 +34,7 @@
 //! - `projection` (default `full`): `pairs` assembles every contact set's projection from
 //!   data on the candidate pairs computed once in the model stage
 //!   ([`FreeInterface::project_on_pairs`]: three more block solves per block of pairs and
-//!   `160 nR^2` bytes there; per contact set no `n x m` basis, no sparse product and no
+//!   `288 nR^2` bytes there; per contact set no `n x m` basis, no sparse product and no
 //!   solve but forming the columns once, two block solves, for the modes a solve
 //!   returns). For studies of many contact sets of a few hundred pairs each (the per-case
 //!   products on the pairs grow as `nA^2` per column). A damped operator is projected the

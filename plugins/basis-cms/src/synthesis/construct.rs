@@ -72,7 +72,7 @@ impl FreeInterface {
     /// [`FreeInterface::new`] (on the given factor of `K` when there is one) with the
     /// moments of the static responses on the pairs as well, so that every contact set's
     /// operator can be projected on the pairs alone ([`FreeInterface::project_on_pairs`]):
-    /// three more block solves per block of pairs, and `160 nR^2` bytes (an error beyond
+    /// three more block solves per block of pairs, and `288 nR^2` bytes (an error beyond
     /// [`PAIR_MOMENTS_LIMIT_BYTES`]).
     ///
     /// [`PAIR_MOMENTS_LIMIT_BYTES`]: super::PAIR_MOMENTS_LIMIT_BYTES
@@ -101,7 +101,13 @@ impl FreeInterface {
         let nm = modes.omega2.len();
         check_inputs(k, m, pairs, modes)?;
         let mut moments = match with_moments {
-            true => Some(PairMoments::zeros(k, m, pairs, modes)?),
+            true => Some(PairMoments::zeros(
+                k,
+                m,
+                pairs,
+                modes,
+                super::PAIR_MOMENTS_LIMIT_BYTES,
+            )?),
             false => None,
         };
         let factor = match factor {

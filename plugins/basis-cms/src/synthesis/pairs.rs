@@ -1,34 +1,32 @@
 //! The projection of a contact set's operator assembled on the pairs alone
 //! ([`FreeInterface::project_on_pairs`]): no `n x m` basis is formed, no sparse product
-//! or solve is made per contact set.
+//! or solve is made per contact set but forming the columns for the modes returned.
 //!
-//! Every vector of the `cms` basis is `u = Phi e + Z a + Y b`, with `Z = K^-1 L` and
-//! `Y = K^-1 M K^-1 L` the first- and second-order static responses to the unit pair
-//! loads `L = (Pn^T | Pt^T)` of the candidate pairs, and `a`, `b` nonzero on the active
-//! pairs only. With `K Phi = M Phi Omega^2`, `Phi^T M Phi = I` and the moments
-//! `W_k = L^T K^-1 (M K^-1)^k L` (`k = 0..3`, `2nR x 2nR`, computed once per model by three
-//! more block solves per block of pairs), every inner product the projection needs is
-//! one on the pairs:
+//! Every vector of the `cms` basis is `u = Phi e + Z a + Y b` on the free modes `Phi` and
+//! the static responses to the unit pair loads `L = (Pn^T | Pt^T)` of the candidate
+//! pairs, deflated M-orthogonally of the modes at every level:
+//! `Z = K^-1 L - Phi C_0`, `Y = K^-1 M Z - Phi C_1` (`C = Phi^T M (.)`, computed), with
+//! `a`, `b` nonzero on the active pairs only. Because `K Z = L - K Phi C_0`,
+//! `K Y = M Z - K Phi C_1` and `Phi^T M (Z, Y, K^-1 M Y) = 0` hold to round-off whatever the
+//! accuracy of the modes, every Gram block of `(Z, Y)` in `K` and `M` is a pair-row product
+//! of `Z`, `K^-1 M Z`, `K^-1 M Y` or `K^-1 M (K^-1 M Y)_deflated` plus a small modal term
+//! (`C^T D`, `D = Phi^T K (Z, Y)`): the model stage computes them once, three block solves
+//! more per block of pairs, `288 nR^2` bytes in all (`PairMoments`). (Subtracting the
+//! modal parts through `K^-1 M Phi = Phi Omega^-2` instead loses the second-order blocks
+//! entirely: with eigen solver accuracy, `Omega^-4` amplifies the error to O(1).)
 //!
-//! | | `Phi` | `Z` | `Y` |
-//! |---|---|---|---|
-//! | `Phi^T K` | `Omega^2` | `P^T` | `Omega^-2 P^T` |
-//! | `Z^T K` | | `W_0` | `W_1` |
-//! | `Y^T K` | | | `W_2` |
-//! | `Phi^T M` | `I` | `Omega^-2 P^T` | `Omega^-4 P^T` |
-//! | `Z^T M` | | `W_1` | `W_2` |
-//! | `Y^T M` | | | `W_3` |
+//! The vectors satisfy the ties, so `V^T X_c V = U^T X U` for the free `X` (`U` the
+//! vectors on the unconstrained DOFs), and the friction parts `V^T F_X V =
+//! (Pt U)^T (E_s X U)` need the pin-normal rows `E_s X U`: `E_s K Z = E_s L - E_s K Phi
+//! C_0`, `E_s K Y = E_s M Z - E_s K Phi C_1`, with `E_s M Z`, `E_s M Y`, `E_s M Phi`,
+//! `E_s K Phi` kept. The basis is `M`-orthonormalized through its Gram matrix (the
+//! eigenvectors of the scaled Gram matrix above a relative cut [`GRAM_CUT`]); its columns
+//! are formed once, on the first expansion, for the modes a solve returns ([`PairColumns`],
+//! two block solves).
 //!
-//! with `P = L^T Phi`. The vectors satisfy the ties, so `V^T X_c V = U^T X U` for the free
-//! `X` (`U` the vectors on the unconstrained DOFs), and the friction parts
-//! `V^T F_X V = (Pt U)^T (E_s X U)` need the pin-normal rows `E_s X U`: `E_s K Z = E_s L`
-//! (the unit normal loads' own rows), `E_s K Y = E_s M Z`, `E_s K Phi = E_s M Phi
-//! Omega^2`, with `E_s M Phi`, `E_s M Z` and `E_s M Y` kept too. The basis is
-//! `M`-orthonormalized through its Gram matrix (the eigenvectors of the scaled Gram
-//! matrix above a relative cut [`GRAM_CUT`]), and the reduced vectors of the modes a solve
-//! returns are expanded on demand ([`PairColumns`], two block solves).
-//!
-//! Undamped operators only: the `cms` basis projects a damped one the explicit way.
+//! Undamped operators only: the `cms` basis projects a damped one the explicit way. The
+//! per-case products on the pairs grow as `(2 nA)^2` per column: this pays for contact
+//! sets of a few hundred pairs, not for thousands.
 
 use super::{add_pair_load, par, FreeInterface, PairDofs, Synthesized};
 use squeal_core::faer::linalg::matmul::matmul;
@@ -98,23 +96,24 @@ fn l_rows(pairs: &[PairDofs], x: MatRef<'_, f64>) -> Mat<f64> {
 
 impl PairMoments {
     /// Empty moments for `pairs`, with the modal products; an error when they would pass
-    /// [`PAIR_MOMENTS_LIMIT_BYTES`].
+    /// `limit_bytes` ([`PAIR_MOMENTS_LIMIT_BYTES`] in the model stage).
     pub(super) fn zeros(
         k: SparseRef<'_>,
         m: SparseRef<'_>,
         pairs: &[PairDofs],
         modes: &RealModes,
+        limit_bytes: usize,
     ) -> Result<Self> {
         let nr = pairs.len();
         let bytes = 288usize.saturating_mul(nr).saturating_mul(nr);
-        if bytes > PAIR_MOMENTS_LIMIT_BYTES {
+        if bytes > limit_bytes {
             return Err(Error::param(
                 "projection",
                 format!(
-                    "`pairs` needs {:.1} GiB of moments for {nr} candidate pairs (limit \
-                     {:.0} GiB): use projection=full",
+                    "`pairs` needs {:.2} GiB of moments for {nr} candidate pairs (limit \
+                     {:.2} GiB): use projection=full",
                     bytes as f64 / (1u64 << 30) as f64,
-                    PAIR_MOMENTS_LIMIT_BYTES as f64 / (1u64 << 30) as f64
+                    limit_bytes as f64 / (1u64 << 30) as f64
                 ),
             ));
         }

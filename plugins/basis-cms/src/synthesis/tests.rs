@@ -301,3 +301,19 @@ fn pairs_projection_is_the_projection_of_its_columns() {
         }
     }
 }
+
+#[test]
+fn pair_moments_beyond_their_memory_limit_are_refused() {
+    let (k, m) = model();
+    let args = (sparse(&k), mass(&m), pairs(), modes(&k, &m, 6));
+    let moments = |limit| {
+        super::pairs::PairMoments::zeros(args.0.as_ref(), args.1.as_ref(), &args.2, &args.3, limit)
+    };
+    // 4 pairs: 288 * 16 bytes
+    assert!(moments(288 * 16).is_ok());
+    let err = moments(288 * 16 - 1).err().expect("refused").to_string();
+    assert!(
+        err.contains("projection") && err.contains("4 candidate pairs"),
+        "{err}"
+    );
+}
