@@ -261,13 +261,14 @@ pub struct PairsProjection {
     pub columns: PairColumns,
     /// Candidate columns removed by the Gram cut.
     pub dropped: usize,
-    /// Largest normal gap `|Pn_A u|` of the columns relative to their largest
-    /// displacement on the pairs (the ties hold to round-off).
+    /// Largest normal gap `|Pn_A u|` of the columns relative to their largest sliding
+    /// displacement `|Pt_A u|` (the ties hold to round-off).
     pub tie_residual: f64,
 }
 
-/// The columns `V` of a `cms` basis projected on the pairs, kept by their coefficients:
-/// `u = Phi e + K^-1 (L_A a + M K^-1 L_A b)`, relabelled onto the constrained DOFs.
+/// The columns `V` of a `cms` basis projected on the pairs, kept by their coefficients on
+/// `(Phi, Z, Y)` of the active pairs (module docs), relabelled onto the constrained DOFs
+/// when formed.
 pub struct PairColumns {
     factor: Arc<Cholesky>,
     phi: Arc<Mat<f64>>,
