@@ -318,3 +318,34 @@ fn cms_projection_option_is_checked() {
         .to_string();
     assert!(err.contains("projection") && err.contains("pairs"), "{err}");
 }
+
+#[test]
+fn a_damped_operator_is_projected_the_full_way_under_projection_pairs() {
+    let (reg, prep) = setup();
+    let mu = 0.5;
+    let eq = prep.equilibrium(&reg, "lcp", "lagrange", mu).unwrap();
+    let damping = Damping {
+        rayleigh_alpha_per_s: Some(20.0),
+        rayleigh_beta_s: Some(1e-7),
+        ..Damping::default()
+    };
+    let op = damped_operator(&prep.model, &damping, &prep.set, &eq.eq.active).unwrap();
+    assert!(op.cc.is_some());
+    let run = |projection: &str| {
+        let p = Params::new().with("projection", ParamValue::Str(projection.into()));
+        let mut m = Method::new(&reg, "cms", &p, "dense", "arpack", params()).unwrap();
+        m.prepare_stage(&prep.model, &prep.set).unwrap();
+        m.solve(&op, mu, true).unwrap().0
+    };
+    let (full, pairs) = (run("full"), run("pairs"));
+    assert!(!pairs
+        .info
+        .notes
+        .iter()
+        .any(|n| n.contains("projected on the pairs")));
+    assert_eq!(full.len(), pairs.len());
+    for (a, b) in full.lambda.iter().zip(&pairs.lambda) {
+        assert!((a - b).norm() <= 1e-10 * a.norm(), "{a} vs {b}");
+    }
+    assert!(pairs.lambda.iter().any(|l| l.re < 0.0), "no damped mode");
+}
