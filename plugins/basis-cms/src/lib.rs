@@ -169,18 +169,13 @@ impl ReductionBasis for CmsBasis {
     /// has one.
     fn prepare(&self, free: &FreeModel<'_>) -> Result<Option<ModelStage>> {
         let modes = (free.normal_modes)(self.modes_factor * free.band_hz.1)?;
-        let fi = match &free.k_factor {
-            _ if self.on_pairs => FreeInterface::with_pair_moments(
-                free.k,
-                free.m,
-                free.pairs,
-                &modes,
-                free.k_factor.clone(),
-            )?,
-            Some(factor) => {
-                FreeInterface::with_factor(free.k, free.m, free.pairs, &modes, factor.clone())?
-            }
-            None => FreeInterface::new(free.k, free.m, free.pairs, &modes)?,
+        let (k, m, pairs, factor) = (free.k, free.m, free.pairs, free.k_factor.clone());
+        let fi = if self.on_pairs {
+            FreeInterface::with_pair_moments(k, m, pairs, &modes, factor)?
+        } else if let Some(factor) = factor {
+            FreeInterface::with_factor(k, m, pairs, &modes, factor)?
+        } else {
+            FreeInterface::new(k, m, pairs, &modes)?
         };
         Ok(Some(Arc::new(fi)))
     }

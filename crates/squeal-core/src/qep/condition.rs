@@ -454,11 +454,11 @@ pub(super) fn condition_numbers(
     left: MatRef<'_, c64>,
     eta: &[f64],
 ) -> (Vec<f64>, Vec<f64>) {
-    use super::residual::{at, interleave, split_columns, terms_times};
+    use super::residual::{at, in_two_halves, interleave, terms_times};
     let n = q.n;
     // y^H Q'(lambda) x = y^H (2 lambda M x + C x) for all pairs, one pass over each matrix
     // per block of columns
-    let pairs = split_columns(lambda.len(), |lo, hi| {
+    let pairs = in_two_halves(lambda.len(), |lo, hi| {
         let w = hi - lo;
         let x = interleave(right, lo, hi);
         let mx = terms_times(n, &q.m, &x, w);

@@ -137,7 +137,7 @@ pub(super) fn backward_errors(
     u: MatRef<'_, c64>,
 ) -> Vec<f64> {
     let (n, k) = (u.nrows(), u.ncols());
-    split_columns(k, |lo, hi| {
+    in_two_halves(k, |lo, hi| {
         let w = hi - lo;
         let x = interleave(u, lo, hi);
         let (mx, kx) = (terms_times(n, &qep.m, &x, w), terms_times(n, &qep.k, &x, w));
@@ -195,7 +195,7 @@ pub(super) fn terms_times(
 }
 
 /// `block(lo, hi)` over the `k` columns split between two threads, results in order.
-pub(super) fn split_columns<T: Send>(
+pub(super) fn in_two_halves<T: Send>(
     k: usize,
     block: impl Fn(usize, usize) -> Vec<T> + Sync,
 ) -> Vec<T> {
@@ -208,7 +208,7 @@ pub(super) fn split_columns<T: Send>(
     }
     let (mut first, second) = std::thread::scope(|s| {
         let h = s.spawn(|| block(mid, k));
-        (block(0, mid), h.join().expect("backward error thread"))
+        (block(0, mid), h.join().expect("column block thread"))
     });
     first.extend(second);
     first

@@ -2,9 +2,11 @@
 //! contact flexibilities) and what it tells about itself.
 
 use super::pairs::PairMoments;
-use super::{add_pair_load, par, FreeInterface, PairDofs, Stored, STORE_LIMIT_BYTES};
+use super::{
+    add_pair_load, par, pn_rows, pt_rows, FreeInterface, PairDofs, Stored, STORE_LIMIT_BYTES,
+};
 use squeal_core::faer::linalg::matmul::matmul;
-use squeal_core::faer::{Accum, Mat, MatRef};
+use squeal_core::faer::{Accum, Mat};
 use squeal_core::linalg::Cholesky;
 use squeal_core::FrictionalOperator;
 use squeal_core::RealModes;
@@ -121,22 +123,9 @@ impl FreeInterface {
             }
             None => Arc::new(Cholesky::new(k, "K (free-interface synthesis)")?),
         };
-        let pn_rows = |x: MatRef<'_, f64>| {
-            Mat::from_fn(nr, x.ncols(), |i, c| {
-                x[(pairs[i].pin[2], c)] - x[(pairs[i].disc[2], c)]
-            })
-        };
-        let pt_rows = |x: MatRef<'_, f64>| {
-            Mat::from_fn(nr, x.ncols(), |i, c| {
-                let p = &pairs[i];
-                (0..2)
-                    .map(|a| p.direction[a] * (x[(p.pin[a], c)] - x[(p.disc[a], c)]))
-                    .sum()
-            })
-        };
         let phi = modes.vectors.clone();
-        let pn_phi = pn_rows(phi.as_ref());
-        let pt_phi = pt_rows(phi.as_ref());
+        let pn_phi = pn_rows(pairs, phi.as_ref());
+        let pt_phi = pt_rows(pairs, phi.as_ref());
         // Pn K^-1 Pn^T and Pn K^-1 Pt^T, a block of pairs at a time; the whole responses
         // kept when they fit
         let mut wfull = Mat::<f64>::zeros(nr, nr);
@@ -161,7 +150,7 @@ impl FreeInterface {
             }
             factor.solve_in_place(x.as_mut());
             if let Some(mo) = moments.as_mut() {
-                mo.add_block(&factor, m, pairs, &phi, c0, b, &x);
+                mo.add_block(&factor, m, pairs, (&phi, &pn_phi, &pt_phi), c0, b, &x);
             }
             if let Some(st) = stored.as_mut() {
                 st.zn
@@ -173,7 +162,7 @@ impl FreeInterface {
                     .subcols_mut(c0, b)
                     .copy_from(x.as_ref().subcols(b, b));
             }
-            let rows = pn_rows(x.as_ref());
+            let rows = pn_rows(pairs, x.as_ref());
             wfull
                 .as_mut()
                 .subcols_mut(c0, b)

@@ -30,7 +30,7 @@
 //!
 //! Normals are `+e_z` (flat disc face), as in the operator builder.
 
-use squeal_core::faer::{Mat, Par};
+use squeal_core::faer::{Mat, MatRef, Par};
 use squeal_core::linalg::Cholesky;
 use squeal_core::SparseMat;
 use std::sync::Arc;
@@ -99,6 +99,23 @@ pub const STORE_LIMIT_BYTES: usize = 3 << 30;
 
 fn par() -> Par {
     squeal_core::faer::get_global_parallelism()
+}
+
+/// `Pn x`: the normal gaps of the pairs (pin minus disc), `nR x c`.
+fn pn_rows(pairs: &[PairDofs], x: MatRef<'_, f64>) -> Mat<f64> {
+    Mat::from_fn(pairs.len(), x.ncols(), |i, c| {
+        x[(pairs[i].pin[2], c)] - x[(pairs[i].disc[2], c)]
+    })
+}
+
+/// `Pt x`: the sliding displacements of the pairs along their directions, `nR x c`.
+fn pt_rows(pairs: &[PairDofs], x: MatRef<'_, f64>) -> Mat<f64> {
+    Mat::from_fn(pairs.len(), x.ncols(), |i, c| {
+        let p = &pairs[i];
+        (0..2)
+            .map(|a| p.direction[a] * (x[(p.pin[a], c)] - x[(p.disc[a], c)]))
+            .sum()
+    })
 }
 
 /// Adds to column `c` of `x` the pair loads `Pn^T normal + Pt^T sliding` of pair `p`

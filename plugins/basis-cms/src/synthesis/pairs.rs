@@ -28,7 +28,7 @@
 //! per-case products on the pairs grow as `(2 nA)^2` per column: this pays for contact
 //! sets of a few hundred pairs, not for thousands.
 
-use super::{add_pair_load, par, FreeInterface, PairDofs, Synthesized};
+use super::{add_pair_load, par, pn_rows, pt_rows, FreeInterface, PairDofs, Synthesized};
 use squeal_core::faer::linalg::matmul::matmul;
 use squeal_core::faer::linalg::solvers::Solve;
 use squeal_core::faer::{Accum, Mat, MatRef, Par, Side};
@@ -80,16 +80,13 @@ pub(crate) struct PairMoments {
 
 /// `L^T x`: the normal gaps of the pairs, then their sliding displacements (`2nR` rows).
 fn l_rows(pairs: &[PairDofs], x: MatRef<'_, f64>) -> Mat<f64> {
+    let (n, t) = (pn_rows(pairs, x), pt_rows(pairs, x));
     let nr = pairs.len();
     Mat::from_fn(2 * nr, x.ncols(), |i, c| {
         if i < nr {
-            let p = &pairs[i];
-            x[(p.pin[2], c)] - x[(p.disc[2], c)]
+            n[(i, c)]
         } else {
-            let p = &pairs[i - nr];
-            (0..2)
-                .map(|a| p.direction[a] * (x[(p.pin[a], c)] - x[(p.disc[a], c)]))
-                .sum()
+            t[(i - nr, c)]
         }
     })
 }
@@ -149,7 +146,7 @@ impl PairMoments {
         factor: &Cholesky,
         m: SparseRef<'_>,
         pairs: &[PairDofs],
-        phi: &Mat<f64>,
+        (phi, pn_phi, pt_phi): (&Mat<f64>, &Mat<f64>, &Mat<f64>),
         c0: usize,
         b: usize,
         z: &Mat<f64>,
@@ -199,18 +196,10 @@ impl PairMoments {
         // D_0 = Phi^T L - (Phi^T K Phi) C_0 (the columns' own rows of P = L^T Phi),
         // D_1 = Phi^T M Z - (Phi^T K Phi) C_1
         let p_cols = Mat::from_fn(phi.ncols(), 2 * b, |i, j| {
-            let (pair, sliding) = if j < b {
-                (c0 + j, false)
+            if j < b {
+                pn_phi[(c0 + j, i)]
             } else {
-                (c0 + j - b, true)
-            };
-            let p = &pairs[pair];
-            if sliding {
-                (0..2)
-                    .map(|a| p.direction[a] * (phi[(p.pin[a], i)] - phi[(p.disc[a], i)]))
-                    .sum()
-            } else {
-                phi[(p.pin[2], i)] - phi[(p.disc[2], i)]
+                pt_phi[(c0 + j - b, i)]
             }
         });
         let d_0 = p_cols - mul_with(self.k_phi.as_ref(), c_0.as_ref(), Par::Seq);
