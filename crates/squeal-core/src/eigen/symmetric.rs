@@ -3,7 +3,7 @@
 //! the dense solver ([`dense_symmetric`]).
 
 use super::{too_many_modes, validate_params, EigenParams};
-use crate::linalg::{norm1, norm2, spmv};
+use crate::linalg::{dot, norm1, norm2, sparse_transpose_times};
 use crate::operator::{RealModes, SolveInfo, StopReason};
 use crate::spectral::{ShiftInvert, SpectralTransform};
 use crate::{Error, Result, SparseRef};
@@ -159,24 +159,32 @@ pub fn finish_real_modes(
         .map(|(i, &l)| (l, i))
         .collect();
     keep.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut out_vec = Mat::<f64>::zeros(n, keep.len());
-    let mut residuals = Vec::with_capacity(keep.len());
-    let (mut kx, mut mx) = (vec![0.0; n], vec![0.0; n]);
-    for (c, &(l, i)) in keep.iter().enumerate() {
-        let mut x: Vec<f64> = (0..n).map(|r| vectors[(r, i)]).collect();
-        spmv(problem.m, &x, &mut mx);
-        let scale = crate::linalg::dot(&x, &mx).sqrt();
+    // M-normalization and residuals by two block products (K and M are symmetric, so
+    // the gather products apply): one pass over each matrix for all the modes
+    let mut out_vec = Mat::from_fn(n, keep.len(), |r, c| vectors[(r, keep[c].1)]);
+    let mx = sparse_transpose_times(problem.m, out_vec.as_ref());
+    let scales: Vec<f64> = (0..keep.len())
+        .map(|c| dot(col(&out_vec, c), col(&mx, c)).sqrt())
+        .collect();
+    for (c, &scale) in scales.iter().enumerate() {
         if scale > 0.0 {
-            x.iter_mut().for_each(|v| *v /= scale);
-        }
-        spmv(problem.k, &x, &mut kx);
-        spmv(problem.m, &x, &mut mx);
-        let r: Vec<f64> = kx.iter().zip(&mx).map(|(a, b)| a - l * b).collect();
-        residuals.push(norm2(&r) / ((kn + l.abs() * mn) * norm2(&x)));
-        for r in 0..n {
-            out_vec[(r, c)] = x[r];
+            out_vec.col_mut(c).iter_mut().for_each(|v| *v /= scale);
         }
     }
+    let kx = sparse_transpose_times(problem.k, out_vec.as_ref());
+    let residuals: Vec<f64> = keep
+        .iter()
+        .enumerate()
+        .map(|(c, &(l, _))| {
+            let scale = if scales[c] > 0.0 { scales[c] } else { 1.0 };
+            let r: Vec<f64> = col(&kx, c)
+                .iter()
+                .zip(col(&mx, c))
+                .map(|(a, b)| a - l * b / scale)
+                .collect();
+            norm2(&r) / ((kn + l.abs() * mn) * norm2(col(&out_vec, c)))
+        })
+        .collect();
     let omega2: Vec<f64> = keep.iter().map(|p| p.0).collect();
     let freq_hz = omega2.iter().map(|&l| l.max(0.0).sqrt() / two_pi).collect();
     RealModes {
@@ -186,6 +194,11 @@ pub fn finish_real_modes(
         residuals,
         info,
     }
+}
+
+/// Column `c` of a column-major matrix as a slice.
+fn col(x: &Mat<f64>, c: usize) -> &[f64] {
+    x.col(c).try_as_col_major().unwrap().as_slice()
 }
 
 /// Dense solution of the whole symmetric pencil (small problems and oracles):

@@ -1,5 +1,6 @@
 //! Products of real sparse matrices with complex vectors, and the complex 2-norm.
 
+use super::clear_vector_uppers;
 use crate::{c64, SparseRef};
 use faer::Mat;
 
@@ -11,6 +12,7 @@ pub fn spmv_complex(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
 
 /// `y += A x` for a real sparse matrix and a complex vector.
 pub(crate) fn spmv_complex_add(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
+    clear_vector_uppers();
     debug_assert_eq!(x.len(), a.ncols());
     debug_assert_eq!(y.len(), a.nrows());
     for j in 0..a.ncols() {
@@ -27,6 +29,7 @@ pub(crate) fn spmv_complex_add(a: SparseRef<'_>, x: &[c64], y: &mut [c64]) {
 /// `A x` for a real sparse matrix and a complex vector, as an `n x 2` real block
 /// (columns: real and imaginary parts), ready for a real factorization's solve.
 pub(crate) fn spmv_complex_split(a: SparseRef<'_>, x: &[c64]) -> Mat<f64> {
+    clear_vector_uppers();
     let mut b = Mat::<f64>::zeros(a.nrows(), 2);
     for j in 0..a.ncols() {
         let (xr, xi) = (x[j].re, x[j].im);
@@ -42,6 +45,7 @@ pub(crate) fn spmv_complex_split(a: SparseRef<'_>, x: &[c64]) -> Mat<f64> {
 }
 
 pub(crate) fn norm2_c(x: &[c64]) -> f64 {
+    clear_vector_uppers();
     x.iter()
         .map(|v| v.re * v.re + v.im * v.im)
         .sum::<f64>()
