@@ -263,14 +263,15 @@ fn gather_block<const W: usize>(
 /// Clears the upper halves of the vector registers (`vzeroupper`) on x86-64 CPUs with
 /// AVX; a no-op elsewhere.
 ///
-/// faer's AVX-512 matrix-product kernels (hand-written assembly) return with the upper
-/// bits of the vector registers in use. Until something clears them, every legacy-SSE
-/// instruction on that thread, which is what this crate's scalar loops compile to for
-/// the baseline x86-64 target, pays a merge with those bits: measured on the rig's mass
-/// matrix (12 million entries), a 16-column product took 0.36 s after a dense product on
-/// the same thread against 0.06 s before, and stayed so until the next `vzeroupper`. The
-/// hot kernels of this crate (sparse products, dot products, norms) call this on entry,
-/// on whichever thread runs them.
+/// faer's AVX-512 matrix-product kernels (the `private-gemm-x86` crate) return with the
+/// upper bits of the vector registers in use. Until something clears them, the
+/// legacy-SSE code that this crate's scalar loops compile to for the baseline x86-64
+/// target runs several times slower on that thread: on an AMD EPYC with AVX-512, a
+/// 16-column product with the rig's mass matrix (12 million entries) took 0.36 s after a
+/// dense product on the same thread against 0.06 s before, and stayed so until the next
+/// `vzeroupper` (the input data, allocation, subnormals and idle pool threads were each
+/// ruled out). The hot kernels of this crate (sparse products, dot products, norms) call
+/// this on entry, on whichever thread runs them; it costs one instruction.
 #[inline]
 pub fn clear_vector_uppers() {
     #[cfg(target_arch = "x86_64")]
