@@ -7,7 +7,7 @@
 use crate::family::{reference_modes, run_family_sweep, FamilySweep, Parametric, SweepCoupling};
 use crate::mu_sweep::value_list;
 use crate::outdir::{self, RunError};
-use crate::pipeline::{FreeModes, Method};
+use crate::pipeline::{FreeModes, Method, MODAL_SOLVER};
 use crate::sweep::files::{max_error_bound, open_checkpoint, write_csv, SweepEvent};
 use serde::Serialize;
 use squeal_core::{EigenParams, Params, Registry};
@@ -180,13 +180,13 @@ pub fn run_into(
     )?;
     let at_first = || outdir::stage(format!("{} at {name} = {}", dir.display(), values[0]));
     let reference =
-        reference_modes(registry, &first, "arpack", 1.5 * s.band_hz[1]).map_err(at_first())?;
+        reference_modes(registry, &first, MODAL_SOLVER, 1.5 * s.band_hz[1]).map_err(at_first())?;
     let mut method = Method::new(
         registry,
         &s.basis,
         &s.basis_params,
         &s.eigen,
-        "arpack",
+        MODAL_SOLVER,
         EigenParams {
             fmin_hz: s.band_hz[0],
             fmax_hz: s.band_hz[1],

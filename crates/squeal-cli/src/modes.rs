@@ -29,7 +29,7 @@ pub struct ModesArgs {
     #[arg(long, default_value_t = 10_500.0)]
     max_freq: f64,
     /// Eigen solver plugin.
-    #[arg(long, default_value = "arpack")]
+    #[arg(long, default_value = squeal_analysis::pipeline::MODAL_SOLVER)]
     eigen: String,
     /// Relative tolerance of the eigen solver.
     #[arg(long, default_value = "1e-10")]

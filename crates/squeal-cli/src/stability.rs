@@ -274,7 +274,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
         a.basis,
         &crate::opts::parse_params(a.basis_opts)?,
         a.eigen,
-        "arpack",
+        squeal_analysis::pipeline::MODAL_SOLVER,
         params,
     )?;
     method.set_condition(a.condition);

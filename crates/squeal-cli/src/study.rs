@@ -194,7 +194,7 @@ fn solve_spec(o: &StudyOpts, scene: &squeal_scene::Scene) -> Result<SolveSpec> {
         basis: m.basis.clone(),
         basis_params: m.basis_opt.clone(),
         eigen: m.eigen(),
-        modal: "arpack".into(),
+        modal: squeal_analysis::pipeline::MODAL_SOLVER.into(),
         band_hz: m.band_of(scene)?,
         tol: m.tol,
         dvr_tol: m.dvr_tol,

@@ -88,7 +88,7 @@ impl BenchOptions {
             eigens: registry.eigen.names(),
             vary: Vec::new(),
             defaults: true,
-            modal: "arpack".into(),
+            modal: crate::pipeline::MODAL_SOLVER.into(),
             accuracy: Accuracy::default(),
             condition: false,
         }

@@ -6,7 +6,7 @@
 //! into an output directory (checkpoint, `sweep.csv`, `summary.json`).
 
 use crate::family::{run_family_sweep, SceneMu};
-use crate::pipeline::{FreeModes, Method, Prepared, Result};
+use crate::pipeline::{FreeModes, Method, Prepared, Result, MODAL_SOLVER};
 use crate::profile::Profile;
 use crate::sweep::{Branch, Checkpoint, SweepPoint};
 use serde::Serialize;
@@ -174,7 +174,7 @@ pub fn run_sweep(
         &s.basis,
         &s.basis_params,
         &s.eigen,
-        "arpack",
+        MODAL_SOLVER,
         params,
     )?;
     method.set_condition(s.condition);
@@ -190,7 +190,7 @@ pub fn run_sweep(
         );
     }
     let t = Instant::now();
-    let free = prep.free_interface_modes(registry, "arpack", 1.5 * s.band_hz[1])?;
+    let free = prep.free_interface_modes(registry, MODAL_SOLVER, 1.5 * s.band_hz[1])?;
     profile.add("free modes of tracking", t.elapsed().as_secs_f64());
     let mut family = SceneMu::new(prep, registry, &s.equilibrium, &s.law, &s.law_params);
     let sweep = run_family_sweep(

@@ -8,6 +8,10 @@ mod stage;
 pub use method::{run_mu_sweep, solve_modes, sweep_point, Method, StepResult, StepTimes};
 pub use stage::{prepare_stage, prepare_stage_alone, stage_keys};
 
+/// The eigen solver of every real-mode problem the analyses solve (body modes, free and
+/// tied real modes of the bases, the modes of tracking), by registered name.
+pub const MODAL_SOLVER: &str = "arpack";
+
 use crate::modal_cache::{CachedModal, ModalCache};
 use squeal_contact::{
     build_operator, damping_matrix, problem, reference_load, solve_on, ContactError, ContactSet,

@@ -20,7 +20,7 @@ use crate::mu_sweep::{
     matching_coupling, mu_list, run_into, MuSweep, MuSweepSettings, SweepEvent, SweepSummary,
 };
 use crate::outdir::{self, RunError};
-use crate::pipeline::{Method, Prepared};
+use crate::pipeline::{Method, Prepared, MODAL_SOLVER};
 use crate::profile::{peak_rss_mb, Profile};
 use crate::reference::paper;
 use serde::Serialize;
@@ -212,7 +212,7 @@ pub fn run(
         file,
         BodyKind::Disc,
         DISC_MODES_TOP_HZ,
-        "arpack",
+        MODAL_SOLVER,
         1e-10,
     )?;
     let table2 = crate::modal::compare_table2(&disc.modes);
@@ -231,7 +231,7 @@ pub fn run(
         file,
         BodyKind::Pin,
         PIN_MODES_TOP_HZ,
-        "arpack",
+        MODAL_SOLVER,
         1e-10,
     )?;
     let pin_below: Vec<ModeRecord> = pin
@@ -413,7 +413,7 @@ fn references(
             "none",
             &Params::new(),
             &s.eigen,
-            "arpack",
+            MODAL_SOLVER,
             params.clone(),
         )
         .map_err(at())?;
@@ -429,7 +429,7 @@ fn references(
                         basis,
                         &Params::new(),
                         "dense",
-                        "arpack",
+                        MODAL_SOLVER,
                         params.clone(),
                     )
                     .map_err(at())?;
