@@ -3,7 +3,7 @@
 //! the dense solver ([`dense_symmetric`]).
 
 use super::{too_many_modes, validate_params, EigenParams};
-use crate::linalg::{dot, norm1, norm2, sparse_transpose_times};
+use crate::linalg::{col, dot, norm1, norm2, sparse_transpose_times};
 use crate::operator::{RealModes, SolveInfo, StopReason};
 use crate::spectral::{ShiftInvert, SpectralTransform};
 use crate::{Error, Result, SparseRef};
@@ -162,13 +162,12 @@ pub fn finish_real_modes(
     // M-normalization and residuals by two block products (K and M are symmetric, so
     // the gather products apply): one pass over each matrix for all the modes
     let mut out_vec = Mat::from_fn(n, keep.len(), |r, c| vectors[(r, keep[c].1)]);
-    let mx = sparse_transpose_times(problem.m, out_vec.as_ref());
-    let scales: Vec<f64> = (0..keep.len())
-        .map(|c| dot(col(&out_vec, c), col(&mx, c)).sqrt())
-        .collect();
-    for (c, &scale) in scales.iter().enumerate() {
+    let mut mx = sparse_transpose_times(problem.m, out_vec.as_ref());
+    for c in 0..keep.len() {
+        let scale = dot(col(&out_vec, c), col(&mx, c)).sqrt();
         if scale > 0.0 {
             out_vec.col_mut(c).iter_mut().for_each(|v| *v /= scale);
+            mx.col_mut(c).iter_mut().for_each(|v| *v /= scale);
         }
     }
     let kx = sparse_transpose_times(problem.k, out_vec.as_ref());
@@ -176,11 +175,10 @@ pub fn finish_real_modes(
         .iter()
         .enumerate()
         .map(|(c, &(l, _))| {
-            let scale = if scales[c] > 0.0 { scales[c] } else { 1.0 };
             let r: Vec<f64> = col(&kx, c)
                 .iter()
                 .zip(col(&mx, c))
-                .map(|(a, b)| a - l * b / scale)
+                .map(|(a, b)| a - l * b)
                 .collect();
             norm2(&r) / ((kn + l.abs() * mn) * norm2(col(&out_vec, c)))
         })
@@ -194,11 +192,6 @@ pub fn finish_real_modes(
         residuals,
         info,
     }
-}
-
-/// Column `c` of a column-major matrix as a slice.
-fn col(x: &Mat<f64>, c: usize) -> &[f64] {
-    x.col(c).try_as_col_major().unwrap().as_slice()
 }
 
 /// Dense solution of the whole symmetric pencil (small problems and oracles):

@@ -313,6 +313,11 @@ pub fn norm1(a: SparseRef<'_>) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// Column `c` of a column-major dense matrix as a slice (every `Mat` is column-major).
+pub(crate) fn col(x: &Mat<f64>, c: usize) -> &[f64] {
+    x.col(c).try_as_col_major().unwrap().as_slice()
+}
+
 /// Euclidean norm.
 pub fn norm2(x: &[f64]) -> f64 {
     clear_vector_uppers();

@@ -3,7 +3,7 @@
 //! SVD compression ([`m_svd_compress`]).
 
 use super::{par, sparse_times, tmul};
-use crate::linalg::{dot, spmv};
+use crate::linalg::{col, dot, spmv};
 use crate::{Error, Result, SparseRef};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef};
@@ -126,9 +126,7 @@ pub fn m_orthonormal_extend_imaged(
         let mut mblk = sparse_times(m, blk.as_ref());
         let mut alive = vec![true; b];
         for c in 0..b {
-            let nrm = dot(blk.col(c).try_as_col_major().unwrap().as_slice(), {
-                mblk.col(c).try_as_col_major().unwrap().as_slice()
-            });
+            let nrm = dot(col(&blk, c), col(&mblk, c));
             if !(nrm.is_finite() && nrm > 0.0) {
                 alive[c] = false;
                 continue;
@@ -155,8 +153,8 @@ pub fn m_orthonormal_extend_imaged(
             // instead of one sparse product per pass; it is recomputed exactly only when
             // cancellation left `w` short (below RECOMPUTE_BELOW of the unit norm it started
             // from), where the carried product's relative error would grow
-            w.copy_from_slice(blk.col(c).try_as_col_major().unwrap().as_slice());
-            mw.copy_from_slice(mblk.col(c).try_as_col_major().unwrap().as_slice());
+            w.copy_from_slice(col(&blk, c));
+            mw.copy_from_slice(col(&mblk, c));
             let before = dot(&w, &mw).max(0.0).sqrt();
             if before < rank_tol || before.is_nan() {
                 dropped += 1;
