@@ -18,6 +18,7 @@ use squeal::core::reduction::{
     friction_load_directions, m_orthonormality_error, m_orthonormalize, solve_reduced,
     sparse_times, StaticSolver, DEFAULT_RANK_TOL,
 };
+use squeal::core::spectral::SpectralTransform;
 use squeal::core::{
     c64, Basis, BasisRequest, EigenParams, EigenSolver, FrictionalOperator, Params,
     ReducedOperator, ReductionBasis, Registry, SymmetricProblem,
@@ -407,6 +408,58 @@ fn the_rank_cut_keeps_badly_scaled_and_nearly_parallel_static_vectors() {
     );
     assert!((g1 - 1.0).abs() < 1e-6, "{g1}");
     assert!(g2 < 1e-3, "{g2}");
+}
+
+/// The real modes on the factorization of a static solver (`enriched` and `residue` share
+/// one per basis) are the modes the solver finds with its own: same frequencies, small
+/// residuals, and no factorization counted; at a positive shift the operator's `sigma`
+/// is minus that shift, and an `M` of another size is refused.
+#[test]
+fn real_modes_on_the_static_solvers_factor_match_a_fresh_solve() {
+    let reg = squeal::registry();
+    let prep = Prepared::new(&reg, coarse(), "coarse").unwrap();
+    let eq = prep.equilibrium(&reg, "lcp", "lagrange", 0.3).unwrap();
+    let op = prep.operator(&eq.eq.active).unwrap();
+    let problem = SymmetricProblem {
+        k: op.kc.as_ref(),
+        m: op.mc.as_ref(),
+    };
+    let arpack = solver(&reg, "arpack");
+    let fresh = arpack.solve_symmetric(&problem, &params(3750.0)).unwrap();
+    assert_eq!(fresh.info.factorizations, 1);
+    for shift_hz in [0.0, 150.0] {
+        let shift = (2.0 * std::f64::consts::PI * shift_hz).powi(2);
+        let statics = StaticSolver::new(&op, shift).unwrap();
+        let si = statics.shift_invert(op.mc.as_ref()).unwrap();
+        assert_eq!(si.shift(), -shift);
+        let shared = arpack
+            .solve_symmetric_on(&problem, &si, &params(3750.0))
+            .unwrap();
+        println!(
+            "shift {shift_hz} Hz: {} modes ({} fresh), {} factorizations, highest {:.3} Hz",
+            shared.freq_hz.len(),
+            fresh.freq_hz.len(),
+            shared.info.factorizations,
+            shared.freq_hz.last().unwrap()
+        );
+        assert_eq!(shared.info.factorizations, 0);
+        assert_eq!(shared.freq_hz.len(), fresh.freq_hz.len());
+        for (a, b) in shared.freq_hz.iter().zip(&fresh.freq_hz) {
+            assert!((a - b).abs() <= 1e-9 * b, "{a} Hz against {b} Hz");
+        }
+        assert!(
+            shared.residuals.iter().all(|&r| r < 1e-10),
+            "{:?}",
+            shared.residuals
+        );
+    }
+    let statics = StaticSolver::new(&op, 0.0).unwrap();
+    // one pair tied: more DOFs than the tied system of every active pair
+    let mut one = vec![false; eq.eq.active.len()];
+    one[eq.eq.active.iter().position(|&a| a).unwrap()] = true;
+    let free = prep.operator(&one).unwrap();
+    assert!(free.dim() > op.dim());
+    assert!(statics.shift_invert(free.mc.as_ref()).is_err());
 }
 
 // ------------------------------------------------------------------------------------

@@ -17,6 +17,7 @@
 use squeal_core::eigen::SymmetricProblem;
 use squeal_core::operator::RealModes;
 use squeal_core::operator::{ComplexModes, Qep};
+use squeal_core::spectral::ShiftInvert;
 use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Result, SparseRef};
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -162,17 +163,13 @@ impl CachedModal {
     pub fn new(inner: Arc<dyn EigenSolver>, cache: Arc<ModalCache>) -> Self {
         Self { inner, cache }
     }
-}
 
-impl EigenSolver for CachedModal {
-    fn name(&self) -> &str {
-        self.inner.name()
-    }
-
-    fn solve_symmetric(
+    /// The cached answer to `(problem, params)`, or `solve`'s, then cached.
+    fn cached(
         &self,
         problem: &SymmetricProblem<'_>,
         params: &EigenParams,
+        solve: impl FnOnce() -> Result<RealModes>,
     ) -> Result<RealModes> {
         let key = Key {
             solver: self.inner.name().to_string(),
@@ -188,9 +185,38 @@ impl EigenSolver for CachedModal {
             );
             return Ok(modes);
         }
-        let modes = self.inner.solve_symmetric(problem, params)?;
+        let modes = solve()?;
         self.cache.put(key, Arc::new(modes.clone()));
         Ok(modes)
+    }
+}
+
+impl EigenSolver for CachedModal {
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
+
+    fn solve_symmetric(
+        &self,
+        problem: &SymmetricProblem<'_>,
+        params: &EigenParams,
+    ) -> Result<RealModes> {
+        self.cached(problem, params, || {
+            self.inner.solve_symmetric(problem, params)
+        })
+    }
+
+    /// Served from the cache like [`solve_symmetric`](Self::solve_symmetric) (the modes of
+    /// one band do not depend on the shift that found them); a miss solves on `op`.
+    fn solve_symmetric_on(
+        &self,
+        problem: &SymmetricProblem<'_>,
+        op: &ShiftInvert<'_>,
+        params: &EigenParams,
+    ) -> Result<RealModes> {
+        self.cached(problem, params, || {
+            self.inner.solve_symmetric_on(problem, op, params)
+        })
     }
 
     fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {
@@ -286,6 +312,11 @@ mod tests {
         assert_eq!(first.omega2, again.omega2);
         assert_eq!(first.vectors, again.vectors);
         assert!(again.info.notes.iter().any(|n| n.contains("reused")));
+        // on a caller's factorization: the same band, so served from the cache too
+        let si = ShiftInvert::new(k.as_ref(), m.as_ref(), 0.0).unwrap();
+        let on = solver.solve_symmetric_on(&p, &si, &params(2)).unwrap();
+        assert_eq!((calls.load(Ordering::SeqCst), cache.hits()), (1, 2));
+        assert_eq!(on.omega2, first.omega2);
 
         // one changed value of K, or changed parameters: solved again
         let k2 = diagonal(&[4.0, 9.0, 16.000000000000004]);

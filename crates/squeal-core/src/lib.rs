@@ -44,7 +44,8 @@ pub use contact::{
     ModelStage, PairDofs, ReductionBasis,
 };
 pub use eigen::{
-    solve_symmetric_band, EigenParams, EigenSolver, KernelOutput, SymmetricKernel, SymmetricProblem,
+    solve_symmetric_band, solve_symmetric_band_on, EigenParams, EigenSolver, KernelOutput,
+    SymmetricKernel, SymmetricProblem,
 };
 pub use error::{Error, Result};
 pub use lowrank::{FrictionLowRank, SymmetricPencil, SymmetricShift, Woodbury};

@@ -36,7 +36,7 @@
 use squeal_core::faer::Mat;
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
-    coupled_real_modes, m_orthonormalize, GrowingBasis, StaticSolver, DEFAULT_RANK_TOL,
+    coupled_real_modes_on, m_orthonormalize, GrowingBasis, StaticSolver, DEFAULT_RANK_TOL,
 };
 use squeal_core::{
     Basis, BasisRequest, EigenParams, Error, Params, ReductionBasis, Registry, Result,
@@ -132,12 +132,14 @@ impl ReductionBasis for ResidueBasis {
         let mc = op.mc.as_ref();
         let (fmin, fmax) = request.band_hz;
         let cutoff = self.cutoff_factor * fmax;
-        let modes = coupled_real_modes(request, cutoff)?;
+        // one factorization of K_s serves the real modes (shift-invert at sigma = -shift)
+        // and every static response
+        let shift = (2.0 * std::f64::consts::PI * self.shift_hz).powi(2);
+        let ks = StaticSolver::new(op, shift)?;
+        let modes = coupled_real_modes_on(request, cutoff, &ks)?;
         let (v, mut dropped) = m_orthonormalize(mc, modes.vectors.as_ref(), self.rank_tol)?;
         let start_size = v.ncols();
         let mut v = GrowingBasis::new(op, v)?;
-        let shift = (2.0 * std::f64::consts::PI * self.shift_hz).powi(2);
-        let ks = StaticSolver::new(op, shift)?;
         let targets = EigenParams {
             fmin_hz: fmin * (1.0 - TARGET_MARGIN),
             fmax_hz: fmax * (1.0 + TARGET_MARGIN),

@@ -2,6 +2,7 @@
 
 use super::{EigenParams, SymmetricProblem};
 use crate::operator::{ComplexModes, FrictionalOperator, Qep, RealModes};
+use crate::spectral::ShiftInvert;
 use crate::{Error, Result};
 
 /// The eigen solver plugin trait: real normal modes of a symmetric pencil and complex
@@ -15,6 +16,20 @@ pub trait EigenSolver: Send + Sync {
         problem: &SymmetricProblem<'_>,
         params: &EigenParams,
     ) -> Result<RealModes>;
+    /// The normal modes as [`solve_symmetric`](Self::solve_symmetric), on a shift-invert
+    /// operator whose factorization the caller already holds (its shift replaces
+    /// `params.shift_hz`), so a caller that also solves with `K - sigma M` (static
+    /// responses) factorizes once. The default, for solvers that do not work by
+    /// shift-invert, ignores `op`.
+    fn solve_symmetric_on(
+        &self,
+        problem: &SymmetricProblem<'_>,
+        op: &ShiftInvert<'_>,
+        params: &EigenParams,
+    ) -> Result<RealModes> {
+        let _ = op;
+        self.solve_symmetric(problem, params)
+    }
     /// All complex modes of `qep` with frequency in `[params.fmin_hz, params.fmax_hz]`.
     fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {
         let _ = (qep, params);

@@ -5,7 +5,7 @@
 use super::{too_many_modes, validate_params, EigenParams};
 use crate::linalg::{col, dot, norm1, norm2, sparse_transpose_times};
 use crate::operator::{RealModes, SolveInfo, StopReason};
-use crate::spectral::{ShiftInvert, SpectralTransform};
+use crate::spectral::{LinOp, ShiftInvert, SpectralTransform};
 use crate::{Error, Result, SparseRef};
 use faer::Mat;
 use std::time::Instant;
@@ -55,17 +55,57 @@ pub fn solve_symmetric_band(
     params: &EigenParams,
 ) -> Result<RealModes> {
     let start = Instant::now();
-    let n = problem.k.nrows();
     validate_params(params)?;
-    if n == 0 {
+    if problem.k.nrows() == 0 {
         return Err(Error::Invalid("empty eigenproblem (no free DOFs)".into()));
     }
     let two_pi = 2.0 * std::f64::consts::PI;
     let shift_hz = params.shift_hz.unwrap_or(params.fmax_hz / 20.0).abs();
     let sigma = -(two_pi * shift_hz).powi(2);
     let op = ShiftInvert::new(problem.k, problem.m, sigma)?;
+    band(solver, kernel, problem, &op, params, 1, start)
+}
+
+/// [`solve_symmetric_band`] on a shift-invert operator the caller factorized (its shift
+/// replaces `params.shift_hz`; it must lie below the spectrum): no factorization here.
+pub fn solve_symmetric_band_on(
+    solver: &str,
+    kernel: &dyn SymmetricKernel,
+    problem: &SymmetricProblem<'_>,
+    op: &ShiftInvert<'_>,
+    params: &EigenParams,
+) -> Result<RealModes> {
+    let start = Instant::now();
+    validate_params(params)?;
+    let n = problem.k.nrows();
+    if n == 0 {
+        return Err(Error::Invalid("empty eigenproblem (no free DOFs)".into()));
+    }
+    if op.dim() != n {
+        return Err(Error::Dimension {
+            context: "symmetric band: the shift-invert operator's size".into(),
+            expected: n,
+            got: op.dim(),
+        });
+    }
+    band(solver, kernel, problem, op, params, 0, start)
+}
+
+/// The band driver's iteration on the factorized `op` (`factorizations` made for it).
+fn band(
+    solver: &str,
+    kernel: &dyn SymmetricKernel,
+    problem: &SymmetricProblem<'_>,
+    op: &ShiftInvert<'_>,
+    params: &EigenParams,
+    factorizations: usize,
+    start: Instant,
+) -> Result<RealModes> {
+    let n = problem.k.nrows();
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let sigma = op.shift();
     let mut info = SolveInfo {
-        factorizations: 1,
+        factorizations,
         ..SolveInfo::new(solver)
     };
     let top = (two_pi * params.fmax_hz).powi(2);
@@ -79,7 +119,7 @@ pub fn solve_symmetric_band(
     } else {
         let mut nev = params.nev_hint.unwrap_or(24).clamp(1, n - 1);
         loop {
-            let out = kernel.largest(&op, nev, params.tol, params.max_restarts)?;
+            let out = kernel.largest(op, nev, params.tol, params.max_restarts)?;
             info.iterations += out.iterations;
             info.requested = nev;
             info.converged = out.theta.len();

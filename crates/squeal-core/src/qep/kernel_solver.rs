@@ -3,9 +3,11 @@
 
 use super::{solve_frictional_band, solve_qep_band, ComplexKernel};
 use crate::eigen::{
-    solve_symmetric_band, EigenParams, EigenSolver, SymmetricKernel, SymmetricProblem,
+    solve_symmetric_band, solve_symmetric_band_on, EigenParams, EigenSolver, SymmetricKernel,
+    SymmetricProblem,
 };
 use crate::operator::{ComplexModes, FrictionalOperator, Qep, RealModes};
+use crate::spectral::ShiftInvert;
 use crate::Result;
 
 /// An [`EigenSolver`] made of a symmetric and a complex Krylov kernel: normal modes by
@@ -50,6 +52,15 @@ impl<S: SymmetricKernel, C: ComplexKernel> EigenSolver for KernelSolver<S, C> {
         params: &EigenParams,
     ) -> Result<RealModes> {
         solve_symmetric_band(self.name, &self.symmetric, problem, params)
+    }
+
+    fn solve_symmetric_on(
+        &self,
+        problem: &SymmetricProblem<'_>,
+        op: &ShiftInvert<'_>,
+        params: &EigenParams,
+    ) -> Result<RealModes> {
+        solve_symmetric_band_on(self.name, &self.symmetric, problem, op, params)
     }
 
     fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {

@@ -1,7 +1,7 @@
 //! The vectors bases start from: the coupled mu = 0 real modes ([`coupled_real_modes`])
 //! and the friction load directions ([`friction_load_directions`]).
 
-use super::sparse_times;
+use super::{sparse_times, StaticSolver};
 use crate::contact::BasisRequest;
 use crate::eigen::{EigenParams, SymmetricProblem};
 use crate::operator::{FrictionalOperator, RealModes};
@@ -11,6 +11,26 @@ use faer::Mat;
 /// The coupled mu = 0 real modes of `(K_c, M_c)` from 0 to `cutoff_hz`, by
 /// `request.modal` (tolerances from `request.params`).
 pub fn coupled_real_modes(request: &BasisRequest<'_>, cutoff_hz: f64) -> Result<RealModes> {
+    real_modes(request, cutoff_hz, None)
+}
+
+/// [`coupled_real_modes`] on the factorization of a [`StaticSolver`] (`K_c + shift M_c`,
+/// the shift-invert operator's `sigma = -shift`): a basis that needs both the real modes
+/// and static responses factorizes once. A modal solver that does not work by
+/// shift-invert ignores the factor.
+pub fn coupled_real_modes_on(
+    request: &BasisRequest<'_>,
+    cutoff_hz: f64,
+    statics: &StaticSolver,
+) -> Result<RealModes> {
+    real_modes(request, cutoff_hz, Some(statics))
+}
+
+fn real_modes(
+    request: &BasisRequest<'_>,
+    cutoff_hz: f64,
+    statics: Option<&StaticSolver>,
+) -> Result<RealModes> {
     if !(cutoff_hz.is_finite() && cutoff_hz > 0.0) {
         return Err(Error::param(
             "cutoff",
@@ -24,13 +44,17 @@ pub fn coupled_real_modes(request: &BasisRequest<'_>, cutoff_hz: f64) -> Result<
         ..request.params.clone()
     };
     let op = request.op;
-    request.modal.solve_symmetric(
-        &SymmetricProblem {
-            k: op.kc.as_ref(),
-            m: op.mc.as_ref(),
-        },
-        &params,
-    )
+    let problem = SymmetricProblem {
+        k: op.kc.as_ref(),
+        m: op.mc.as_ref(),
+    };
+    match statics {
+        Some(s) => {
+            let si = s.shift_invert(problem.m)?;
+            request.modal.solve_symmetric_on(&problem, &si, &params)
+        }
+        None => request.modal.solve_symmetric(&problem, &params),
+    }
 }
 
 /// The friction load directions `U = T^T P~t^T` as dense columns (`n_c x nA`). When the

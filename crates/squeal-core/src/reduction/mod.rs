@@ -52,7 +52,7 @@ mod statics;
 mod tests;
 
 pub use crate::linalg::expand;
-pub use candidates::{coupled_real_modes, friction_load_directions};
+pub use candidates::{coupled_real_modes, coupled_real_modes_on, friction_load_directions};
 pub use growing::GrowingBasis;
 pub use mac::mac_real_complex;
 pub use orthonormal::{

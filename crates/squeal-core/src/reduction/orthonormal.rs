@@ -195,7 +195,8 @@ pub fn m_orthonormal_extend_imaged(
         }
         c0 += b;
     }
-    let out = out.as_ref().subcols(0, k).to_owned();
+    // the kept columns are the first `k`: truncated in place, not copied
+    out.truncate(n, k);
     Ok((out, dropped))
 }
 

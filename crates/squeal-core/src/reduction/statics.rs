@@ -5,6 +5,7 @@ use super::sparse_times;
 use crate::linalg::spmv_complex;
 use crate::linalg::{add_scaled, Cholesky};
 use crate::operator::FrictionalOperator;
+use crate::spectral::ShiftInvert;
 use crate::{c64, Error, Result, SparseMat, SparseRef};
 use faer::{Mat, MatRef};
 use std::time::Instant;
@@ -43,6 +44,20 @@ impl StaticSolver {
     /// `R <- K_s^-1 R` for a block of right-hand sides.
     pub fn solve_in_place(&self, r: faer::MatMut<'_, f64>) {
         self.factor.solve_in_place(r);
+    }
+
+    /// The shift-invert operator `(K_c + shift M_c)^-1 M_c` (`sigma = -shift`) on this
+    /// solver's factorization, for the real modes of `(K_c, M_c)` by
+    /// [`super::coupled_real_modes_on`]: `m` must be the operator's `M_c`.
+    pub fn shift_invert<'a>(&'a self, m: SparseRef<'a>) -> Result<ShiftInvert<'a>> {
+        if m.nrows() != self.ks.nrows() || m.ncols() != self.ks.ncols() {
+            return Err(Error::Dimension {
+                context: "static solver: M_c of the shift-invert operator".into(),
+                expected: self.ks.nrows(),
+                got: m.nrows(),
+            });
+        }
+        Ok(ShiftInvert::with_factor(m, -self.shift, &self.factor))
     }
 
     /// The factorized matrix `K_s`.

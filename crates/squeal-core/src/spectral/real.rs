@@ -5,15 +5,30 @@
 //! factorization serves every application.
 
 use super::{LinOp, SpectralTransform};
-use crate::linalg::{add_scaled, check_square_finite, spmv, LltFailure, SparseLlt};
+use crate::linalg::{add_scaled, check_square_finite, spmv, Cholesky, LltFailure, SparseLlt};
 use crate::{Error, Result, SparseRef};
 use faer::MatMut;
+
+/// The factor of `K - sigma M`: the operator's own, or one its caller holds.
+enum Factor<'a> {
+    Owned(Box<SparseLlt>),
+    Borrowed(&'a SparseLlt),
+}
+
+impl Factor<'_> {
+    fn llt(&self) -> &SparseLlt {
+        match self {
+            Factor::Owned(l) => l,
+            Factor::Borrowed(l) => l,
+        }
+    }
+}
 
 /// The factorized symmetric shift-invert operator `OP = (K - sigma M)^-1 M`.
 pub struct ShiftInvert<'a> {
     m: SparseRef<'a>,
     sigma: f64,
-    llt: SparseLlt,
+    llt: Factor<'a>,
     applications: std::sync::atomic::AtomicUsize,
 }
 
@@ -39,9 +54,22 @@ impl<'a> ShiftInvert<'a> {
         Ok(Self {
             m,
             sigma,
-            llt,
+            llt: Factor::Owned(Box::new(llt)),
             applications: std::sync::atomic::AtomicUsize::new(0),
         })
+    }
+
+    /// The operator on a factorization the caller already holds: `factor` must be the
+    /// Cholesky factor of `K - sigma M` for this `m` and `sigma` (as the static solver of
+    /// [`crate::reduction::StaticSolver::shift_invert`] guarantees), so real modes and
+    /// static responses share one factorization.
+    pub(crate) fn with_factor(m: SparseRef<'a>, sigma: f64, factor: &'a Cholesky) -> Self {
+        Self {
+            m,
+            sigma,
+            llt: Factor::Borrowed(factor.llt()),
+            applications: std::sync::atomic::AtomicUsize::new(0),
+        }
     }
 
     /// The mass matrix.
@@ -58,7 +86,7 @@ impl<'a> ShiftInvert<'a> {
     pub fn solve_in_place(&self, y: &mut [f64]) {
         let n = y.len();
         let mat = MatMut::from_column_major_slice_mut(y, n, 1);
-        self.llt.solve_in_place(mat);
+        self.llt.llt().solve_in_place(mat);
     }
 
     /// `y = (K - sigma M)^-1 b` where `b = M x` is already known (saves one product).
