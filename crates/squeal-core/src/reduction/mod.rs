@@ -5,7 +5,7 @@
 //!   [`m_orthonormal_extend`]) and an optional SVD compression ([`m_svd_compress`]);
 //! - the coupled mu = 0 real modes ([`coupled_real_modes`]), the friction load directions
 //!   ([`friction_load_directions`]) and static responses with one reused factorization
-//!   ([`StaticSolver`]);
+//!   ([`StaticSolver`]), which the real modes can share ([`coupled_real_modes_on`]);
 //! - projection of every part of a [`FrictionalOperator`](crate::operator::FrictionalOperator) on a basis ([`project`]), or of a
 //!   basis grown column by column with the images of its columns kept ([`GrowingBasis`]), the
 //!   reduced solve with any [`EigenSolver`](crate::EigenSolver), and the expansion of the reduced modes with
@@ -18,7 +18,10 @@
 //! direction only), then orthonormalized by block classical Gram-Schmidt with
 //! re-orthogonalization (every projection done twice, "twice is enough"; a column that
 //! lost more than 90 % of its norm inside its block gets a third pass against every
-//! kept column) in the `M_c` inner product: a QR factorization in that inner product. A
+//! kept column) in the `M_c` inner product: a QR factorization in that inner product.
+//! Inside a block of 32 columns the same is done recursively (left half, right half
+//! projected on what the left half kept, right half; four columns at a time one by one),
+//! so each column of the block is read a logarithmic number of times. A
 //! unit column whose component outside the span of the columns kept before it has an
 //! `M_c` norm below `rank_tol` (the sine of its angle to that span) is dropped and
 //! counted. The Gram matrix `V^T M V` is never diagonalized: its eigenvalues are the

@@ -6,7 +6,7 @@ use super::{par, sparse_times, tmul};
 use crate::linalg::{col, dot, spmv};
 use crate::{Error, Result, SparseRef};
 use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatRef};
+use faer::{Accum, Mat, MatMut, MatRef};
 
 /// Default relative rank cut of the orthonormalization: a unit-`M_c`-norm column is dropped
 /// when the `M_c` norm of its part outside the span of the previous columns (the sine of
@@ -111,14 +111,18 @@ pub fn m_orthonormal_extend_imaged(
         });
     }
     let cap = q.ncols() + new.ncols();
-    let mut out = Mat::<f64>::zeros(n, cap);
-    let mut mout = Mat::<f64>::zeros(n, cap);
-    out.as_mut().subcols_mut(0, q.ncols()).copy_from(q);
-    mout.as_mut().subcols_mut(0, q.ncols()).copy_from(mq);
-    let mut k = q.ncols();
-    let mut dropped = 0;
-    let mut w = vec![0.0; n];
-    let mut mw = vec![0.0; n];
+    let mut ext = Extension {
+        m,
+        rank_tol,
+        out: Mat::<f64>::zeros(n, cap),
+        mout: Mat::<f64>::zeros(n, cap),
+        k: q.ncols(),
+        dropped: 0,
+        w: vec![0.0; n],
+        mw: vec![0.0; n],
+    };
+    ext.out.as_mut().subcols_mut(0, q.ncols()).copy_from(q);
+    ext.mout.as_mut().subcols_mut(0, q.ncols()).copy_from(mq);
     let mut c0 = 0;
     while c0 < new.ncols() {
         let b = BLOCK.min(new.ncols() - c0);
@@ -135,69 +139,145 @@ pub fn m_orthonormal_extend_imaged(
             blk.col_mut(c).iter_mut().for_each(|x| *x *= s);
             mblk.col_mut(c).iter_mut().for_each(|x| *x *= s);
         }
-        // two block passes against the kept columns
-        for _ in 0..2 {
-            if k > 0 {
-                let coef = tmul(mout.as_ref().subcols(0, k), blk.as_ref());
-                sub_mul(blk.as_mut(), out.as_ref().subcols(0, k), coef.as_ref());
-                sub_mul(mblk.as_mut(), mout.as_ref().subcols(0, k), coef.as_ref());
-            }
-        }
-        let k_block = k;
+        ext.project(blk.as_mut(), mblk.as_mut(), 0, ext.k);
+        // the norm each column keeps outside the earlier blocks (it started at 1)
+        let mut before = vec![0.0; b];
         for c in 0..b {
+            if alive[c] {
+                before[c] = dot(col(&blk, c), col(&mblk, c)).max(0.0).sqrt();
+                alive[c] = before[c] >= rank_tol;
+            }
             if !alive[c] {
-                dropped += 1;
-                continue;
+                ext.dropped += 1;
             }
-            // `mw = M w` is carried through the projections (`M (w - Q c) = M w - (M Q) c`)
-            // instead of one sparse product per pass; it is recomputed exactly only when
-            // cancellation left `w` short (below RECOMPUTE_BELOW of the unit norm it started
-            // from), where the carried product's relative error would grow
-            w.copy_from_slice(col(&blk, c));
-            mw.copy_from_slice(col(&mblk, c));
-            let before = dot(&w, &mw).max(0.0).sqrt();
-            if before < rank_tol || before.is_nan() {
-                dropped += 1;
-                continue;
-            }
-            let passes = |w: &mut Vec<f64>, mw: &mut Vec<f64>, from: usize, to: usize| {
-                for _ in 0..2 {
-                    if to > from {
-                        let qq = out.as_ref().subcols(from, to - from);
-                        let mq = mout.as_ref().subcols(from, to - from);
-                        let wm = faer::MatRef::from_column_major_slice(w, n, 1);
-                        let coef = tmul(mq, wm);
-                        let mut wmut = faer::MatMut::from_column_major_slice_mut(w, n, 1);
-                        sub_mul(wmut.as_mut(), qq, coef.as_ref());
-                        let mut mwmut = faer::MatMut::from_column_major_slice_mut(mw, n, 1);
-                        sub_mul(mwmut.as_mut(), mq, coef.as_ref());
-                    }
-                }
-                if dot(w, mw).max(0.0).sqrt() < RECOMPUTE_BELOW {
-                    spmv(m, w, mw);
-                }
-                dot(w, mw).max(0.0).sqrt()
-            };
-            let mut nrm = passes(&mut w, &mut mw, k_block, k);
-            if nrm < 0.1 * before {
-                // heavy cancellation inside the block: one more pass against everything
-                nrm = passes(&mut w, &mut mw, 0, k);
-            }
-            if !(nrm >= rank_tol && nrm.is_finite()) {
-                dropped += 1;
-                continue;
-            }
-            for r in 0..n {
-                out[(r, k)] = w[r] / nrm;
-                mout[(r, k)] = mw[r] / nrm;
-            }
-            k += 1;
         }
+        ext.within(&mut blk, &mut mblk, &alive, &before, 0, b);
         c0 += b;
     }
+    let Extension {
+        mut out,
+        k,
+        dropped,
+        ..
+    } = ext;
     // the kept columns are the first `k`: truncated in place, not copied
     out.truncate(n, k);
     Ok((out, dropped))
+}
+
+/// Columns of a block that a leaf of [`Extension::within`] orthonormalizes one by one.
+const LEAF: usize = 4;
+
+/// The state of [`m_orthonormal_extend_imaged`]: the kept columns `out[.., ..k]` and their
+/// `M` images, and two work vectors.
+struct Extension<'a> {
+    m: SparseRef<'a>,
+    rank_tol: f64,
+    out: Mat<f64>,
+    mout: Mat<f64>,
+    k: usize,
+    dropped: usize,
+    w: Vec<f64>,
+    mw: Vec<f64>,
+}
+
+impl Extension<'_> {
+    /// Two block passes of `B` (with its image `MB` carried along) against the kept
+    /// columns `from..to`.
+    fn project(&self, mut b: MatMut<'_, f64>, mut mb: MatMut<'_, f64>, from: usize, to: usize) {
+        if to <= from {
+            return;
+        }
+        let q = self.out.as_ref().subcols(from, to - from);
+        let mq = self.mout.as_ref().subcols(from, to - from);
+        for _ in 0..2 {
+            let coef = tmul(mq, b.as_ref());
+            sub_mul(b.as_mut(), q, coef.as_ref());
+            sub_mul(mb.as_mut(), mq, coef.as_ref());
+        }
+    }
+
+    /// Orthonormalizes the columns `lo..hi` of a block already projected against the
+    /// earlier blocks, in order, recursively: the left half, then the right half projected
+    /// against what the left half kept (block passes), then the right half; a leaf of
+    /// [`LEAF`] columns goes column by column. The block passes read each column of the
+    /// block a logarithmic number of times instead of once per later column.
+    fn within(
+        &mut self,
+        blk: &mut Mat<f64>,
+        mblk: &mut Mat<f64>,
+        alive: &[bool],
+        before: &[f64],
+        lo: usize,
+        hi: usize,
+    ) {
+        if hi - lo <= LEAF {
+            let k_leaf = self.k;
+            for c in lo..hi {
+                if alive[c] {
+                    self.column(col(blk, c), col(mblk, c), before[c], k_leaf);
+                }
+            }
+            return;
+        }
+        let mid = lo + (hi - lo) / 2;
+        let k_left = self.k;
+        self.within(blk, mblk, alive, before, lo, mid);
+        self.project(
+            blk.as_mut().subcols_mut(mid, hi - mid),
+            mblk.as_mut().subcols_mut(mid, hi - mid),
+            k_left,
+            self.k,
+        );
+        self.within(blk, mblk, alive, before, mid, hi);
+    }
+
+    /// Projects one column (its `M` norm was `before` after the block passes against the
+    /// earlier blocks) against the kept columns `k_leaf..k` of its leaf, twice, and keeps
+    /// it unless it falls under the rank cut. Heavy cancellation inside the block (less
+    /// than a tenth of `before` left) earns one more pass against every kept column.
+    fn column(&mut self, v: &[f64], mv: &[f64], before: f64, k_leaf: usize) {
+        // `mw = M w` is carried through the projections (`M (w - Q c) = M w - (M Q) c`)
+        // instead of one sparse product per pass; it is recomputed exactly only when
+        // cancellation left `w` short (below RECOMPUTE_BELOW of the unit norm it started
+        // from), where the carried product's relative error would grow
+        let mut w = std::mem::take(&mut self.w);
+        let mut mw = std::mem::take(&mut self.mw);
+        w.copy_from_slice(v);
+        mw.copy_from_slice(mv);
+        let mut nrm = self.passes(&mut w, &mut mw, k_leaf);
+        if nrm < 0.1 * before {
+            nrm = self.passes(&mut w, &mut mw, 0);
+        }
+        if nrm >= self.rank_tol && nrm.is_finite() {
+            let k = self.k;
+            for (r, (x, y)) in w.iter().zip(&mw).enumerate() {
+                self.out[(r, k)] = x / nrm;
+                self.mout[(r, k)] = y / nrm;
+            }
+            self.k += 1;
+        } else {
+            self.dropped += 1;
+        }
+        self.w = w;
+        self.mw = mw;
+    }
+
+    /// Two passes of `w` (image `mw`) against the kept columns `from..k`; returns the
+    /// `M` norm left.
+    fn passes(&self, w: &mut [f64], mw: &mut [f64], from: usize) -> f64 {
+        let n = w.len();
+        self.project(
+            MatMut::from_column_major_slice_mut(w, n, 1),
+            MatMut::from_column_major_slice_mut(mw, n, 1),
+            from,
+            self.k,
+        );
+        if dot(w, mw).max(0.0).sqrt() < RECOMPUTE_BELOW {
+            spmv(self.m, w, mw);
+        }
+        dot(w, mw).max(0.0).sqrt()
+    }
 }
 
 /// Compresses the span of the columns of `v` by an SVD in the `M` inner product: columns

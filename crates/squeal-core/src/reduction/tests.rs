@@ -197,6 +197,49 @@ fn nearly_parallel_columns_of_one_block_come_out_m_orthonormal() {
 }
 
 #[test]
+fn blocked_extension_keeps_the_columns_one_by_one_extension_keeps() {
+    // 20 random columns, then 50 combinations of them, perturbed by 1e-3, 1e-7 or not at
+    // all (exact repeats of the span, to drop), across three blocks and their recursive
+    // halves: the blocked extension must keep and drop what Gram-Schmidt column by column
+    // keeps and drops, and span the same space
+    let n = 200;
+    let op = operator(n, 3, true, 9);
+    let m = op.mc.as_ref();
+    let mut rng = Rng(41);
+    let first = rng.mat(n, 20);
+    let mix = rng.mat(20, 50);
+    let noise = rng.mat(n, 50);
+    let combos = &first * &mix;
+    let scale = |c: usize| [1e-3, 1e-7, 0.0][c % 3];
+    let cols = Mat::from_fn(n, 70, |r, c| {
+        if c < 20 {
+            first[(r, c)]
+        } else {
+            combos[(r, c - 20)] + scale(c - 20) * noise[(r, c - 20)]
+        }
+    });
+    let (v, dropped) = m_orthonormalize(m, cols.as_ref(), DEFAULT_RANK_TOL).unwrap();
+    let mut one = Mat::<f64>::zeros(n, 0);
+    let mut one_dropped = 0;
+    for c in 0..70 {
+        let (next, d) =
+            m_orthonormal_extend(m, one.as_ref(), cols.subcols(c, 1), DEFAULT_RANK_TOL).unwrap();
+        one = next;
+        one_dropped += d;
+    }
+    let exact_repeats = (0..50).filter(|&c| scale(c) == 0.0).count();
+    assert_eq!(dropped, exact_repeats);
+    assert_eq!((v.ncols(), dropped), (one.ncols(), one_dropped));
+    assert!(m_orthonormality_error(m, v.as_ref()) < 1e-12);
+    // the same span: each basis M-projected on the other keeps its whole norm
+    let cross = tmul(v.as_ref(), sparse_times(m, one.as_ref()).as_ref());
+    for j in 0..one.ncols() {
+        let kept: f64 = (0..cross.nrows()).map(|i| cross[(i, j)].powi(2)).sum();
+        assert!((kept - 1.0).abs() < 1e-8, "column {j}: {kept}");
+    }
+}
+
+#[test]
 fn svd_compression_keeps_the_dominant_directions() {
     let op = operator(30, 2, true, 3);
     let m = op.mc.as_ref();
