@@ -4,7 +4,7 @@
 //! projection, orthonormalization and residuals of the reduced modes then reuse the
 //! images of the columns kept before.
 
-use super::orthonormal::m_orthonormal_extend_imaged;
+use super::orthonormal::m_orthonormal_extend_in_place;
 use super::project::{dense_to_sparse, project_loads, project_part};
 use super::statics::{energy_norms, StaticSolver};
 use super::{expand, sparse_times, tmul};
@@ -23,16 +23,12 @@ pub struct GrowingBasis<'a> {
     cv: Option<Mat<f64>>,
 }
 
-/// `[a | b]`.
-fn append(a: &Mat<f64>, b: MatRef<'_, f64>) -> Mat<f64> {
-    let m = a.ncols();
-    Mat::from_fn(a.nrows(), m + b.ncols(), |i, j| {
-        if j < m {
-            a[(i, j)]
-        } else {
-            b[(i, j - m)]
-        }
-    })
+/// `a <- [a | b]`, the column capacity of `a` grown in powers of two.
+fn append(a: &mut Mat<f64>, b: MatRef<'_, f64>) {
+    let (n, m) = (a.nrows(), a.ncols());
+    a.reserve(n, (m + b.ncols()).next_power_of_two());
+    a.resize_with(n, m + b.ncols(), |_, _| 0.0);
+    a.as_mut().subcols_mut(m, b.ncols()).copy_from(b);
 }
 
 impl<'a> GrowingBasis<'a> {
@@ -76,17 +72,22 @@ impl<'a> GrowingBasis<'a> {
     /// returns how many columns of `new` were dropped.
     pub fn extend(&mut self, new: MatRef<'_, f64>, rank_tol: f64) -> Result<usize> {
         let mc = self.op.mc.as_ref();
-        let (all, dropped) =
-            m_orthonormal_extend_imaged(mc, self.v.as_ref(), self.mv.as_ref(), new, rank_tol)?;
-        let w = all.as_ref().subcols(self.len(), all.ncols() - self.len());
+        let before = self.len();
+        let dropped = m_orthonormal_extend_in_place(mc, &mut self.v, &mut self.mv, new, rank_tol)?;
+        let w = self.v.as_ref().subcols(before, self.len() - before);
         if w.ncols() > 0 {
-            self.mv = append(&self.mv, sparse_times(mc, w).as_ref());
-            self.kv = append(&self.kv, sparse_times(self.op.kc.as_ref(), w).as_ref());
-            if let (Some(cv), Some(c)) = (&self.cv, &self.op.cc) {
-                self.cv = Some(append(cv, sparse_times(c.as_ref(), w).as_ref()));
+            // the images of the new columns by exact sparse products (the orthonormalization
+            // carried `M w` through its projections, with their roundoff)
+            let mw = sparse_times(mc, w);
+            self.mv
+                .as_mut()
+                .subcols_mut(before, w.ncols())
+                .copy_from(&mw);
+            append(&mut self.kv, sparse_times(self.op.kc.as_ref(), w).as_ref());
+            if let (Some(cv), Some(c)) = (&mut self.cv, &self.op.cc) {
+                append(cv, sparse_times(c.as_ref(), w).as_ref());
             }
         }
-        self.v = all;
         Ok(dropped)
     }
 

@@ -111,18 +111,72 @@ pub fn m_orthonormal_extend_imaged(
         });
     }
     let cap = q.ncols() + new.ncols();
+    let mut out = Mat::<f64>::zeros(n, cap);
+    let mut mout = Mat::<f64>::zeros(n, cap);
+    out.as_mut().subcols_mut(0, q.ncols()).copy_from(q);
+    mout.as_mut().subcols_mut(0, q.ncols()).copy_from(mq);
+    let (out, _, dropped) = extend_into(m, rank_tol, out, mout, q.ncols(), new);
+    Ok((out, dropped))
+}
+
+/// [`m_orthonormal_extend_imaged`] in place: the `M`-orthonormal columns `v` and their
+/// images `mv = M v` grow by the kept directions of `new` (their images carried through
+/// the projections). The column capacity grows geometrically, so a basis extended many
+/// times is not copied each time. Returns the number of columns of `new` dropped.
+pub(crate) fn m_orthonormal_extend_in_place(
+    m: SparseRef<'_>,
+    v: &mut Mat<f64>,
+    mv: &mut Mat<f64>,
+    new: MatRef<'_, f64>,
+    rank_tol: f64,
+) -> Result<usize> {
+    check_rank_tol(rank_tol)?;
+    check_dims(m, v.as_ref(), new)?;
+    let (n, k) = (v.nrows(), v.ncols());
+    if mv.nrows() != n || mv.ncols() != k {
+        return Err(Error::Dimension {
+            context: "M-orthonormalization: the M image of the kept columns".into(),
+            expected: n * k,
+            got: mv.nrows() * mv.ncols(),
+        });
+    }
+    let cap = k + new.ncols();
+    let grown = |a: &mut Mat<f64>| {
+        let mut a = std::mem::replace(a, Mat::new());
+        // capacity in powers of two: reallocated only when the basis doubles
+        a.reserve(n, cap.next_power_of_two());
+        a.resize_with(n, cap, |_, _| 0.0);
+        a
+    };
+    let (out, mout) = (grown(v), grown(mv));
+    let (out, mout, dropped) = extend_into(m, rank_tol, out, mout, k, new);
+    *v = out;
+    *mv = mout;
+    Ok(dropped)
+}
+
+/// The extension proper: `out`, `mout` hold the kept columns and their images in their
+/// first `k` columns and have room for `new`; returns them truncated to the kept columns,
+/// and the number of columns of `new` dropped.
+fn extend_into(
+    m: SparseRef<'_>,
+    rank_tol: f64,
+    out: Mat<f64>,
+    mout: Mat<f64>,
+    k: usize,
+    new: MatRef<'_, f64>,
+) -> (Mat<f64>, Mat<f64>, usize) {
+    let n = m.nrows();
     let mut ext = Extension {
         m,
         rank_tol,
-        out: Mat::<f64>::zeros(n, cap),
-        mout: Mat::<f64>::zeros(n, cap),
-        k: q.ncols(),
+        out,
+        mout,
+        k,
         dropped: 0,
         w: vec![0.0; n],
         mw: vec![0.0; n],
     };
-    ext.out.as_mut().subcols_mut(0, q.ncols()).copy_from(q);
-    ext.mout.as_mut().subcols_mut(0, q.ncols()).copy_from(mq);
     let mut c0 = 0;
     while c0 < new.ncols() {
         let b = BLOCK.min(new.ncols() - c0);
@@ -156,13 +210,15 @@ pub fn m_orthonormal_extend_imaged(
     }
     let Extension {
         mut out,
+        mut mout,
         k,
         dropped,
         ..
     } = ext;
     // the kept columns are the first `k`: truncated in place, not copied
     out.truncate(n, k);
-    Ok((out, dropped))
+    mout.truncate(n, k);
+    (out, mout, dropped)
 }
 
 /// Columns of a block that a leaf of [`Extension::within`] orthonormalizes one by one.
