@@ -6,7 +6,9 @@
 //! vector per active pair), optionally compressed by an SVD in the `M_c` inner product.
 //! Everything is `M_c`-orthonormalized with the rank cut of
 //! [`squeal_core::reduction`] (columns scaled to unit `M_c` norm first, so the static
-//! vectors, of order 1e-9 m per N, survive next to unit-modal-mass modes).
+//! vectors, of order 1e-9 m per N, survive next to unit-modal-mass modes). One sparse
+//! Cholesky factorization of `K_c` serves the modes (shift-invert at 0) and the static
+//! responses; the basis's note gives the time of each step.
 //!
 //! Fixed in mu, not in contact set: built once per contact set (a new active set means
 //! a new `T` and a new basis) and reused across a whole mu sweep

@@ -9,7 +9,8 @@
 //!    frequency in the band widened by [`TARGET_MARGIN`] on each side;
 //! 2. residual of each target on the FULL operator `r_j = Q(lambda_j) V q_j`, static
 //!    response `d_j = K_s^-1 r_j` with one factorization of `K_s = K_c + shift M_c`
-//!    reused for every iteration, energy-norm residual
+//!    reused for every iteration (the real modes of the start are computed on it too),
+//!    energy-norm residual
 //!    `eps_j = sqrt(d_j^H K_s d_j) / sqrt(u_j^H K_s u_j)`
 //!    ([`squeal_core::reduction::energy_residuals`], formed from the images `K_c V`,
 //!    `M_c V` kept by [`GrowingBasis`]: each column is multiplied by the large sparse
