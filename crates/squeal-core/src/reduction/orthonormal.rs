@@ -96,27 +96,9 @@ pub fn m_orthonormal_extend_imaged(
     new: MatRef<'_, f64>,
     rank_tol: f64,
 ) -> Result<(Mat<f64>, usize)> {
-    check_rank_tol(rank_tol)?;
-    check_dims(m, q, new)?;
-    let n = m.nrows();
-    if mq.nrows() != n || mq.ncols() != q.ncols() {
-        return Err(Error::Dimension {
-            context: format!(
-                "M-orthonormalization: the M image of the kept columns is {} x {}",
-                mq.nrows(),
-                mq.ncols()
-            ),
-            expected: n * q.ncols(),
-            got: mq.nrows() * mq.ncols(),
-        });
-    }
-    let cap = q.ncols() + new.ncols();
-    let mut out = Mat::<f64>::zeros(n, cap);
-    let mut mout = Mat::<f64>::zeros(n, cap);
-    out.as_mut().subcols_mut(0, q.ncols()).copy_from(q);
-    mout.as_mut().subcols_mut(0, q.ncols()).copy_from(mq);
-    let (out, _, dropped) = extend_into(m, rank_tol, out, mout, q.ncols(), new);
-    Ok((out, dropped))
+    let (mut v, mut mv) = (q.to_owned(), mq.to_owned());
+    let dropped = m_orthonormal_extend_in_place(m, &mut v, &mut mv, new, rank_tol)?;
+    Ok((v, dropped))
 }
 
 /// [`m_orthonormal_extend_imaged`] in place: the `M`-orthonormal columns `v` and their
@@ -135,7 +117,11 @@ pub(crate) fn m_orthonormal_extend_in_place(
     let (n, k) = (v.nrows(), v.ncols());
     if mv.nrows() != n || mv.ncols() != k {
         return Err(Error::Dimension {
-            context: "M-orthonormalization: the M image of the kept columns".into(),
+            context: format!(
+                "M-orthonormalization: the M image of the kept columns is {} x {}",
+                mv.nrows(),
+                mv.ncols()
+            ),
             expected: n * k,
             got: mv.nrows() * mv.ncols(),
         });
@@ -148,30 +134,11 @@ pub(crate) fn m_orthonormal_extend_in_place(
         a.resize_with(n, cap, |_, _| 0.0);
         a
     };
-    let (out, mout) = (grown(v), grown(mv));
-    let (out, mout, dropped) = extend_into(m, rank_tol, out, mout, k, new);
-    *v = out;
-    *mv = mout;
-    Ok(dropped)
-}
-
-/// The extension proper: `out`, `mout` hold the kept columns and their images in their
-/// first `k` columns and have room for `new`; returns them truncated to the kept columns,
-/// and the number of columns of `new` dropped.
-fn extend_into(
-    m: SparseRef<'_>,
-    rank_tol: f64,
-    out: Mat<f64>,
-    mout: Mat<f64>,
-    k: usize,
-    new: MatRef<'_, f64>,
-) -> (Mat<f64>, Mat<f64>, usize) {
-    let n = m.nrows();
     let mut ext = Extension {
         m,
         rank_tol,
-        out,
-        mout,
+        out: grown(v),
+        mout: grown(mv),
         k,
         dropped: 0,
         w: vec![0.0; n],
@@ -218,13 +185,15 @@ fn extend_into(
     // the kept columns are the first `k`: truncated in place, not copied
     out.truncate(n, k);
     mout.truncate(n, k);
-    (out, mout, dropped)
+    *v = out;
+    *mv = mout;
+    Ok(dropped)
 }
 
 /// Columns of a block that a leaf of [`Extension::within`] orthonormalizes one by one.
 const LEAF: usize = 4;
 
-/// The state of [`m_orthonormal_extend_imaged`]: the kept columns `out[.., ..k]` and their
+/// The state of [`m_orthonormal_extend_in_place`]: the kept columns `out[.., ..k]` and their
 /// `M` images, and two work vectors.
 struct Extension<'a> {
     m: SparseRef<'a>,
