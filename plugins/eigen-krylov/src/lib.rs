@@ -117,6 +117,7 @@ use squeal_core::faer::{self, Par};
 use squeal_core::spectral::{LinOp, ShiftInvert};
 use squeal_core::{EigenSolver, Error, KernelSolver, Params, Registry, Result};
 
+mod block;
 mod lanczos;
 mod pairs;
 pub mod schur;
@@ -154,8 +155,20 @@ const PAR_THRESHOLD: usize = 1 << 16;
 /// Registers the `"krylov"` eigen solver.
 pub fn register(reg: &mut Registry) {
     reg.eigen.register(NAME, DESCRIPTION, |p: &Params| {
-        p.tracked().refuse_unread("eigen", NAME)?;
-        let solver: Box<dyn EigenSolver> = Box::new(KRYLOV);
+        let p = p.tracked();
+        let block = p.usize_or("block", DEFAULT_BLOCK)?;
+        if block == 0 {
+            return Err(Error::param(
+                "block",
+                "the block size of the normal-mode Lanczos must be >= 1 (1: single vector)",
+            ));
+        }
+        p.refuse_unread("eigen", NAME)?;
+        let solver: Box<dyn EigenSolver> = Box::new(KrylovSolver::new(
+            NAME,
+            LanczosKernel { block },
+            KrylovSchurKernel,
+        ));
         Ok(solver)
     });
 }
@@ -164,14 +177,36 @@ pub fn register(reg: &mut Registry) {
 /// modes) and [`KrylovSchurKernel`] (complex modes of the QEP).
 pub type KrylovSolver = KernelSolver<LanczosKernel, KrylovSchurKernel>;
 
-/// The `"krylov"` solver.
-pub const KRYLOV: KrylovSolver = KernelSolver::new(NAME, LanczosKernel, KrylovSchurKernel);
+/// The `"krylov"` solver with its default block size.
+pub const KRYLOV: KrylovSolver = KernelSolver::new(
+    NAME,
+    LanczosKernel {
+        block: DEFAULT_BLOCK,
+    },
+    KrylovSchurKernel,
+);
+
+/// Default of the `block` parameter: columns per application of `OP` in the normal-mode
+/// Lanczos.
+pub const DEFAULT_BLOCK: usize = 8;
 
 /// Thick-restart Lanczos for the largest eigenvalues of `OP = (K - sigma M)^-1 M` in
-/// the `M` inner product, with full reorthogonalization, locking and validation runs
-/// for repeated eigenvalues (see the crate docs for the method).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct LanczosKernel;
+/// the `M` inner product with full reorthogonalization (see the crate docs for the
+/// method): with `block = 1` one vector at a time, with locking and validation runs for
+/// repeated eigenvalues; with `block > 1` on blocks of that many columns (module
+/// `block`), which holds up to `block` copies of a repeated eigenvalue and reads the
+/// factor of `K - sigma M` once per block. Problems too small for the block basis take
+/// the single-vector path.
+#[derive(Debug, Clone, Copy)]
+pub struct LanczosKernel {
+    /// Columns per application of `OP` (1: single-vector Lanczos).
+    pub block: usize,
+}
+
+impl LanczosKernel {
+    /// The single-vector kernel.
+    pub const SINGLE: Self = Self { block: 1 };
+}
 
 impl SymmetricKernel for LanczosKernel {
     fn largest(
@@ -187,6 +222,10 @@ impl SymmetricKernel for LanczosKernel {
                 "tol",
                 format!("relative tolerance must be in (0, 1), got {tol}"),
             ));
+        }
+        let bs = self.block;
+        if bs > 1 && block::fits(n, nev, bs) {
+            return block::largest_block(op, nev, tol, max_restarts, bs);
         }
         let start: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
         largest_from(op, nev, tol, max_restarts, start)

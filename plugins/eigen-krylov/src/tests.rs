@@ -77,11 +77,18 @@ fn params(fmax_hz: f64) -> EigenParams {
 }
 
 fn solve(k: &SparseMat, m: &SparseMat, p: &EigenParams) -> RealModes {
+    solve_with(&KRYLOV, k, m, p)
+}
+
+/// The single-vector solver (`block = 1`).
+const SINGLE: KrylovSolver = KernelSolver::new(NAME, LanczosKernel::SINGLE, KrylovSchurKernel);
+
+fn solve_with(solver: &KrylovSolver, k: &SparseMat, m: &SparseMat, p: &EigenParams) -> RealModes {
     let problem = SymmetricProblem {
         k: k.as_ref(),
         m: m.as_ref(),
     };
-    let modes = KRYLOV.solve_symmetric(&problem, p).unwrap();
+    let modes = solver.solve_symmetric(&problem, p).unwrap();
     eprintln!(
         "n = {}: {} modes, {} restarts, {} op applications, reason {:?}, max residual {:.2e}, notes {:?}",
         k.nrows(),
@@ -264,7 +271,7 @@ fn restart_cap_reports_non_convergence() {
         max_restarts: 1,
         ..params(fmax)
     };
-    let modes = solve(&k, &m, &p);
+    let modes = solve_with(&SINGLE, &k, &m, &p);
     assert_eq!(modes.info.reason, StopReason::MaxIterations);
     assert!(modes.info.iterations <= 1);
     assert_true_eigenvalues(&modes.omega2, &exact, 1e-10);
@@ -277,7 +284,7 @@ fn restart_cap_reports_non_convergence() {
         shift_hz: Some(fmax),
         ..params(fmax)
     };
-    let modes = solve(&k, &m, &p);
+    let modes = solve_with(&SINGLE, &k, &m, &p);
     assert_eq!(modes.info.reason, StopReason::MaxIterations);
     assert!(
         modes.info.converged < modes.info.requested,
@@ -291,7 +298,7 @@ fn restart_cap_reports_non_convergence() {
     // Kernel level, no restart at all: fewer pairs than requested, all of them exact.
     let sigma = -exact[0];
     let op = ShiftInvert::new(k.as_ref(), m.as_ref(), sigma).unwrap();
-    let out = LanczosKernel.largest(&op, 24, 1e-12, 0).unwrap();
+    let out = LanczosKernel::SINGLE.largest(&op, 24, 1e-12, 0).unwrap();
     assert!(!out.all_converged);
     assert_eq!(out.iterations, 0);
     assert!(out.theta.len() < 24, "{}", out.theta.len());
@@ -337,8 +344,8 @@ fn kernel_is_deterministic_and_finds_the_largest() {
     let sigma = -1.0e3;
     let op = ShiftInvert::new(k.as_ref(), m.as_ref(), sigma).unwrap();
     let nev = 12;
-    let a = LanczosKernel.largest(&op, nev, 1e-12, 300).unwrap();
-    let b = LanczosKernel.largest(&op, nev, 1e-12, 300).unwrap();
+    let a = LanczosKernel::SINGLE.largest(&op, nev, 1e-12, 300).unwrap();
+    let b = LanczosKernel::SINGLE.largest(&op, nev, 1e-12, 300).unwrap();
     assert!(a.all_converged);
     assert_eq!(a.theta.len(), nev);
     assert_eq!(a.theta, b.theta);
@@ -373,7 +380,7 @@ fn kernel_handles_tiny_problems_and_full_requests() {
     let (k, m) = (sparse(n, &kt), sparse(n, &mt));
     let op = ShiftInvert::new(k.as_ref(), m.as_ref(), -1.0).unwrap();
     for nev in [0, 1, 6, 7, 9] {
-        let out = LanczosKernel.largest(&op, nev, 1e-12, 50).unwrap();
+        let out = LanczosKernel::SINGLE.largest(&op, nev, 1e-12, 50).unwrap();
         assert!(out.all_converged, "nev = {nev}");
         assert_eq!(out.theta.len(), nev.min(n));
         let mut theta = out.theta.clone();
@@ -383,7 +390,7 @@ fn kernel_handles_tiny_problems_and_full_requests() {
             assert!((t - want).abs() < 1e-12 * want, "nev = {nev}, j = {j}");
         }
     }
-    assert!(LanczosKernel.largest(&op, 3, 0.0, 50).is_err());
+    assert!(LanczosKernel::SINGLE.largest(&op, 3, 0.0, 50).is_err());
 }
 
 #[test]
@@ -498,4 +505,149 @@ fn square_membrane_doublets_match_closed_form() {
     assert_residuals(&modes);
     assert_eq!(modes.info.reason, StopReason::Converged);
     assert_m_orthonormal(&modes.vectors, &m, 1e-9);
+}
+
+/// The two identical chains with consistent mass and varying springs of
+/// `consistent_mass_doublets_match_dense_oracle`: exact doublets.
+fn twin_chains(half: usize) -> (SparseMat, SparseMat) {
+    let spring = |s: usize| K * (1.0 + 0.3 * (s as f64).sin());
+    let (mut kt, mut mt) = (Vec::new(), Vec::new());
+    for off in [0, half] {
+        chain_k(&mut kt, off, half, spring, true);
+        chain_m(&mut mt, off, half, true);
+    }
+    (sparse(2 * half, &kt), sparse(2 * half, &mt))
+}
+
+#[test]
+fn block_kernel_finds_doublets_and_matches_the_dense_oracle() {
+    let (k, m) = twin_chains(200);
+    let problem = SymmetricProblem {
+        k: k.as_ref(),
+        m: m.as_ref(),
+    };
+    let (mut dense, _) = dense_symmetric(&problem).unwrap();
+    dense.sort_by(f64::total_cmp);
+    let sigma = -0.1 * dense[0];
+    let op = ShiftInvert::new(k.as_ref(), m.as_ref(), sigma).unwrap();
+    for block in [2, 5, 8] {
+        let nev = 20;
+        let out = LanczosKernel { block }
+            .largest(&op, nev, 1e-12, 100)
+            .unwrap();
+        assert!(out.all_converged, "block {block}");
+        assert_eq!(out.theta.len(), nev, "block {block}");
+        let mut lam: Vec<f64> = out.theta.iter().map(|&t| op.pencil_eigenvalue(t)).collect();
+        lam.sort_by(f64::total_cmp);
+        let err = max_rel_err(&lam, &dense[..nev]);
+        eprintln!(
+            "block {block}: {} restarts, max relative error {err:.2e}",
+            out.iterations
+        );
+        assert!(err < 1e-10, "block {block}: max relative error {err:e}");
+        assert_m_orthonormal(&out.vectors, &m, 1e-9);
+    }
+}
+
+#[test]
+fn block_and_single_vector_solvers_agree_through_the_band_driver() {
+    let (k, m) = twin_chains(150);
+    let problem = SymmetricProblem {
+        k: k.as_ref(),
+        m: m.as_ref(),
+    };
+    let (mut dense, _) = dense_symmetric(&problem).unwrap();
+    dense.sort_by(f64::total_cmp);
+    let count = 30;
+    let fmax = 0.5 * (hz(dense[count - 1]) + hz(dense[count]));
+    let block = solve(&k, &m, &params(fmax));
+    let single = solve_with(&SINGLE, &k, &m, &params(fmax));
+    assert_eq!(block.omega2.len(), count);
+    assert_eq!(single.omega2.len(), count);
+    assert!(max_rel_err(&block.omega2, &dense[..count]) < 1e-10);
+    assert!(max_rel_err(&single.omega2, &dense[..count]) < 1e-10);
+    assert_residuals(&block);
+    assert_eq!(block.info.reason, StopReason::Converged);
+    assert_m_orthonormal(&block.vectors, &m, 1e-9);
+}
+
+#[test]
+fn block_kernel_restart_cap_returns_only_converged_pairs() {
+    let n = 3000;
+    let (mut kt, mut mt) = (Vec::new(), Vec::new());
+    chain_k(&mut kt, 0, n, |_| K, true);
+    chain_m(&mut mt, 0, n, false);
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    let exact = fixed_chain_spectrum(n);
+    // a long chain's lowest eigenvalues are close (like j^2): one basis without a restart
+    // does not converge all forty
+    let op = ShiftInvert::new(k.as_ref(), m.as_ref(), -exact[0] * 1e-3).unwrap();
+    let out = LanczosKernel { block: 4 }
+        .largest(&op, 40, 1e-12, 0)
+        .unwrap();
+    assert!(!out.all_converged);
+    assert_eq!(out.iterations, 0);
+    assert!(out.theta.len() < 40, "{}", out.theta.len());
+    let lam: Vec<f64> = out.theta.iter().map(|&t| op.pencil_eigenvalue(t)).collect();
+    assert_true_eigenvalues(&lam, &exact, 1e-10);
+}
+
+#[test]
+fn block_kernel_replaces_exhausted_directions() {
+    // M = I, K = diag with three values of multiplicity 80: the block Krylov space of 8
+    // start vectors has dimension 24 (8 copies of each value), so later blocks break
+    // down and take fresh directions. A Krylov method holds at most the block size of
+    // copies of one eigenvalue: 8 are all the lowest value; asking 16 returns true
+    // eigenpairs, M-orthonormal, whatever mix of values the fresh directions reach.
+    let n = 240;
+    let values = [1.0e4, 4.0e4, 9.0e4];
+    let kt: Vec<_> = (0..n).map(|i| Triplet::new(i, i, values[i % 3])).collect();
+    let mt: Vec<_> = (0..n).map(|i| Triplet::new(i, i, 1.0)).collect();
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    let op = ShiftInvert::new(k.as_ref(), m.as_ref(), -1.0e3).unwrap();
+    let kernel = LanczosKernel { block: 8 };
+    let out = kernel.largest(&op, 8, 1e-12, 50).unwrap();
+    assert!(out.all_converged);
+    assert_eq!(out.theta.len(), 8);
+    for t in &out.theta {
+        let l = op.pencil_eigenvalue(*t);
+        assert!((l - 1e4).abs() < 1e-10 * 1e4, "{l}");
+    }
+    assert_m_orthonormal(&out.vectors, &m, 1e-10);
+    let out = kernel.largest(&op, 16, 1e-12, 50).unwrap();
+    assert_eq!(out.theta.len(), 16);
+    for (j, t) in out.theta.iter().enumerate() {
+        let l = op.pencil_eigenvalue(*t);
+        assert!(
+            values.iter().any(|v| (l - v).abs() < 1e-10 * v),
+            "pair {j}: {l} is no eigenvalue"
+        );
+        let x: Vec<f64> = out.vectors.col(j).iter().copied().collect();
+        let kx: Vec<f64> = (0..n).map(|i| values[i % 3] * x[i]).collect();
+        let r = kx
+            .iter()
+            .zip(&x)
+            .map(|(a, b)| (a - l * b).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!(r < 1e-8 * l, "pair {j}: residual {r:e}");
+    }
+    assert_m_orthonormal(&out.vectors, &m, 1e-10);
+}
+
+#[test]
+fn block_parameter_is_read_and_checked() {
+    let mut reg = Registry::new();
+    register(&mut reg);
+    assert!(reg
+        .eigen
+        .create("krylov", &Params::new().with_num("block", 4.0))
+        .is_ok());
+    let e = reg
+        .eigen
+        .create("krylov", &Params::new().with_num("block", 0.0))
+        .err()
+        .expect("block = 0 must be rejected")
+        .to_string();
+    assert!(e.contains("block"), "{e}");
 }

@@ -57,7 +57,12 @@ impl StaticSolver {
                 got: m.nrows(),
             });
         }
-        Ok(ShiftInvert::with_factor(m, -self.shift, &self.factor))
+        Ok(ShiftInvert::with_factor(
+            m,
+            -self.shift,
+            self.ks.as_ref(),
+            &self.factor,
+        ))
     }
 
     /// The factorized matrix `K_s`.

@@ -9,17 +9,30 @@ use crate::linalg::{add_scaled, check_square_finite, spmv, Cholesky, LltFailure,
 use crate::{Error, Result, SparseRef};
 use faer::MatMut;
 
-/// The factor of `K - sigma M`: the operator's own, or one its caller holds.
+/// `K - sigma M` and its factor: the operator's own, or ones its caller holds.
 enum Factor<'a> {
-    Owned(Box<SparseLlt>),
-    Borrowed(&'a SparseLlt),
+    Owned {
+        llt: Box<SparseLlt>,
+        shifted: crate::SparseMat,
+    },
+    Borrowed {
+        llt: &'a SparseLlt,
+        shifted: SparseRef<'a>,
+    },
 }
 
 impl Factor<'_> {
     fn llt(&self) -> &SparseLlt {
         match self {
-            Factor::Owned(l) => l,
-            Factor::Borrowed(l) => l,
+            Factor::Owned { llt, .. } => llt,
+            Factor::Borrowed { llt, .. } => llt,
+        }
+    }
+
+    fn shifted(&self) -> SparseRef<'_> {
+        match self {
+            Factor::Owned { shifted, .. } => shifted.as_ref(),
+            Factor::Borrowed { shifted, .. } => *shifted,
         }
     }
 }
@@ -54,22 +67,38 @@ impl<'a> ShiftInvert<'a> {
         Ok(Self {
             m,
             sigma,
-            llt: Factor::Owned(Box::new(llt)),
+            llt: Factor::Owned {
+                llt: Box::new(llt),
+                shifted,
+            },
             applications: std::sync::atomic::AtomicUsize::new(0),
         })
     }
 
-    /// The operator on a factorization the caller already holds: `factor` must be the
-    /// Cholesky factor of `K - sigma M` for this `m` and `sigma` (as the static solver of
-    /// [`crate::reduction::StaticSolver::shift_invert`] guarantees), so real modes and
-    /// static responses share one factorization.
-    pub(crate) fn with_factor(m: SparseRef<'a>, sigma: f64, factor: &'a Cholesky) -> Self {
+    /// The operator on a factorization the caller already holds: `shifted` must be
+    /// `K - sigma M` for this `m` and `sigma` and `factor` its Cholesky factor (as the
+    /// static solver of [`crate::reduction::StaticSolver::shift_invert`] guarantees), so
+    /// real modes and static responses share one factorization.
+    pub(crate) fn with_factor(
+        m: SparseRef<'a>,
+        sigma: f64,
+        shifted: SparseRef<'a>,
+        factor: &'a Cholesky,
+    ) -> Self {
         Self {
             m,
             sigma,
-            llt: Factor::Borrowed(factor.llt()),
+            llt: Factor::Borrowed {
+                llt: factor.llt(),
+                shifted,
+            },
             applications: std::sync::atomic::AtomicUsize::new(0),
         }
+    }
+
+    /// The shifted matrix `K - sigma M`.
+    pub fn shifted(&self) -> SparseRef<'_> {
+        self.llt.shifted()
     }
 
     /// The mass matrix.
@@ -87,6 +116,16 @@ impl<'a> ShiftInvert<'a> {
         let n = y.len();
         let mat = MatMut::from_column_major_slice_mut(y, n, 1);
         self.llt.llt().solve_in_place(mat);
+    }
+
+    /// `Y <- (K - sigma M)^-1 Y` for a block of columns, each counted as one application
+    /// (`Y = M X` known: `OP X`). One pass over the factor serves every column, which is
+    /// what makes block Krylov methods cheaper per column on large factors.
+    pub fn solve_block_in_place(&self, mut y: MatMut<'_, f64>) {
+        let cols = y.ncols();
+        self.llt.llt().solve_in_place(y.as_mut());
+        self.applications
+            .fetch_add(cols, std::sync::atomic::Ordering::Relaxed);
     }
 
     /// `y = (K - sigma M)^-1 b` where `b = M x` is already known (saves one product).
