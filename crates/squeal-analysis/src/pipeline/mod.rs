@@ -10,7 +10,7 @@ pub use stage::{prepare_stage, prepare_stage_alone, stage_keys};
 
 /// The eigen solver of every real-mode problem the analyses solve (body modes, free and
 /// tied real modes of the bases, the modes of tracking), by registered name.
-pub const MODAL_SOLVER: &str = "arpack";
+pub const MODAL_SOLVER: &str = "krylov";
 
 use crate::modal_cache::{CachedModal, ModalCache};
 use squeal_contact::{
