@@ -1,6 +1,8 @@
-//! Where the time of a run goes: named stages with their wall time and how many times
-//! each ran ([`Profile`]), and the process's peak resident memory ([`peak_rss_mb`]).
-//! Every report (`validate`, sweeps, studies, bench) carries one.
+//! Where the time of a run goes: named stages with their wall time, how many times each
+//! ran and, where the run measured it, the peak resident memory while it ran
+//! ([`Profile`]); the process's peak resident memory ([`peak_rss_mb`]) and the peak since
+//! the last stage ([`take_peak_rss_mb`]). Every report (`validate`, sweeps, studies,
+//! bench) carries one.
 
 use serde::{Deserialize, Serialize};
 use std::fmt::Write;
@@ -14,6 +16,9 @@ pub struct StageTime {
     pub time_s: f64,
     /// How many times it ran.
     pub count: usize,
+    /// Peak resident memory while it ran (MB; the largest over its runs), where measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_rss_mb: Option<f64>,
 }
 
 /// Stages in the order they first ran.
@@ -37,17 +42,40 @@ impl Profile {
 
     /// Adds `count` runs of `stage` that took `time_s` together.
     pub fn add_runs(&mut self, stage: &str, time_s: f64, count: usize) {
+        self.add_measured(stage, time_s, count, None);
+    }
+
+    /// Adds one run of `stage` that took `time_s` with a peak resident memory of
+    /// `peak_rss_mb` (from [`take_peak_rss_mb`] at its end).
+    pub fn add_with_peak(&mut self, stage: &str, time_s: f64, peak_rss_mb: Option<f64>) {
+        self.add_measured(stage, time_s, 1, peak_rss_mb);
+    }
+
+    fn add_measured(&mut self, stage: &str, time_s: f64, count: usize, peak: Option<f64>) {
         match self.stages.iter_mut().find(|s| s.stage == stage) {
             Some(s) => {
                 s.time_s += time_s;
                 s.count += count;
+                s.peak_rss_mb = match (s.peak_rss_mb, peak) {
+                    (Some(a), Some(b)) => Some(a.max(b)),
+                    (a, b) => a.or(b),
+                };
             }
             None => self.stages.push(StageTime {
                 stage: stage.to_string(),
                 time_s,
                 count,
+                peak_rss_mb: peak,
             }),
         }
+    }
+
+    /// The largest stage peak (MB), where any was measured.
+    pub fn peak_rss_mb(&self) -> Option<f64> {
+        self.stages
+            .iter()
+            .filter_map(|s| s.peak_rss_mb)
+            .reduce(f64::max)
     }
 
     /// Appends the stages of `other`, their names prefixed by `prefix` (e.g. `sweep cms:
@@ -64,11 +92,19 @@ impl Profile {
     }
 
     /// A Markdown table: stage, runs, time (s), share of `wall_s` (the run's wall time;
-    /// stages nested in others or run outside the profile make the shares not sum to 100).
+    /// stages nested in others or run outside the profile make the shares not sum to 100)
+    /// and, when any stage measured it, its peak resident memory (MB).
     pub fn markdown(&self, wall_s: f64) -> String {
-        let mut md = String::from("| stage | runs | time (s) | share |\n|---|---|---|---|\n");
+        let peaks = self.stages.iter().any(|s| s.peak_rss_mb.is_some());
+        let mut md = if peaks {
+            String::from(
+                "| stage | runs | time (s) | share | peak RSS (MB) |\n|---|---|---|---|---|\n",
+            )
+        } else {
+            String::from("| stage | runs | time (s) | share |\n|---|---|---|---|\n")
+        };
         for s in &self.stages {
-            let _ = writeln!(
+            let _ = write!(
                 md,
                 "| {} | {} | {:.1} | {:.0} % |",
                 s.stage,
@@ -76,6 +112,13 @@ impl Profile {
                 s.time_s,
                 100.0 * s.time_s / wall_s.max(f64::MIN_POSITIVE)
             );
+            if peaks {
+                let _ = match s.peak_rss_mb {
+                    Some(mb) => write!(md, " {mb:.0} |"),
+                    None => write!(md, " - |"),
+                };
+            }
+            md.push('\n');
         }
         md
     }
@@ -88,6 +131,18 @@ pub fn peak_rss_mb() -> Option<f64> {
     let line = text.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb / 1024.0)
+}
+
+/// Peak resident memory (MB) since the previous call (or the process's start), then the
+/// mark reset to the memory resident now (Linux: `VmHWM` of `/proc/self/status`, reset by
+/// writing `5` to `/proc/self/clear_refs`), so each stage of a run gets its own peak.
+/// After a call, [`peak_rss_mb`] gives the peak since that call, not the process's: a run
+/// that takes stage peaks reports the largest of them as its peak. `None` where the files
+/// do not exist; when the reset is refused the peaks are cumulative (still upper bounds).
+pub fn take_peak_rss_mb() -> Option<f64> {
+    let peak = peak_rss_mb()?;
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+    Some(peak)
 }
 
 #[cfg(test)]
@@ -110,6 +165,42 @@ mod tests {
         assert_eq!(q.stages[1].stage, "sweep: solve");
         let md = p.markdown(12.0);
         assert!(md.contains("| basis | 2 | 5.0 | 42 % |"), "{md}");
+    }
+
+    #[test]
+    fn stage_peaks_are_kept_and_tabled() {
+        let mut p = Profile::new();
+        p.add_with_peak("model", 2.0, Some(900.0));
+        p.add_with_peak("sweep", 4.0, Some(1500.0));
+        p.add_with_peak("sweep", 1.0, Some(1200.0));
+        p.add("report", 0.5);
+        assert_eq!(p.stages[1].peak_rss_mb, Some(1500.0));
+        assert_eq!(p.stages[2].peak_rss_mb, None);
+        assert_eq!(p.peak_rss_mb(), Some(1500.0));
+        let md = p.markdown(10.0);
+        assert!(md.contains("| peak RSS (MB) |"), "{md}");
+        assert!(md.contains("| sweep | 2 | 5.0 | 50 % | 1500 |"), "{md}");
+        assert!(md.contains("| report | 1 | 0.5 | 5 % | - |"), "{md}");
+        // without measured peaks the table keeps four columns
+        assert!(!Profile::new().markdown(1.0).contains("peak"));
+    }
+
+    #[test]
+    fn a_stage_peak_sees_memory_freed_before_it_ends() {
+        if !std::path::Path::new("/proc/self/clear_refs").exists() {
+            return;
+        }
+        // 256 MB touched and freed inside the stage: its peak holds them
+        let _ = take_peak_rss_mb();
+        let before = peak_rss_mb().unwrap();
+        let big = vec![1u8; 256 << 20];
+        std::hint::black_box(&big);
+        drop(big);
+        let stage = take_peak_rss_mb().unwrap();
+        assert!(
+            stage >= before + 200.0,
+            "stage peak {stage} MB, before {before} MB"
+        );
     }
 
     #[test]

@@ -31,6 +31,21 @@
 //! `H <- diag(theta_k)`), `Q` becomes the next block, and the coupling `R Y_k,l` between
 //! them is recovered by the next expansion's Gram-Schmidt coefficients (Stewart 2001).
 //!
+//! ## Locking and purification
+//!
+//! The relation above holds only to the accuracy of the block solves (about
+//! `cond(K - sigma M) eps theta_max`), which can exceed the tolerance asked of the
+//! smallest wanted `theta`. Two steps keep the solves' error out of the results:
+//! - at a restart, the kept Ritz vectors that passed the test are *locked*: their coupling
+//!   to the following blocks is held at zero (recomputed, it is the solves' error, which
+//!   would undo their convergence at every restart);
+//! - at the end, each returned pair's residual `OP x - theta x` is computed explicitly;
+//!   when one exceeds the tolerance, one Rayleigh-Ritz step on `span [X, R]` with
+//!   `K - sigma M` and `M` themselves (not the Krylov relation) refines the pairs, each
+//!   input pair taking the Ritz vector that overlaps it most. Residuals within the
+//!   tolerance (or at rounding level) add no direction: in a multiple eigenvalue their
+//!   noise would bring in unconverged copies.
+//!
 //! Start block: deterministic pseudo-random columns, so results are reproducible.
 
 use super::{par_for, Directions, BREAKDOWN};

@@ -651,3 +651,41 @@ fn block_parameter_is_read_and_checked() {
         .to_string();
     assert!(e.contains("block"), "{e}");
 }
+
+#[test]
+fn calls_above_the_block_pair_cap_take_the_single_vector_kernel() {
+    let n = 3000;
+    let (mut kt, mut mt) = (Vec::new(), Vec::new());
+    chain_k(&mut kt, 0, n, |_| K, true);
+    chain_m(&mut mt, 0, n, false);
+    let (k, m) = (sparse(n, &kt), sparse(n, &mt));
+    let exact = fixed_chain_spectrum(n);
+    let op = ShiftInvert::new(k.as_ref(), m.as_ref(), -exact[0]).unwrap();
+    let above = BLOCK_MAX_NEV + 4;
+    let block = LanczosKernel { block: 8 }
+        .largest(&op, above, 1e-10, 300)
+        .unwrap();
+    let single = LanczosKernel::SINGLE
+        .largest(&op, above, 1e-10, 300)
+        .unwrap();
+    // the same path: the same pairs to the last bit, all of them true eigenvalues
+    assert!(block.all_converged);
+    assert_eq!(block.theta, single.theta);
+    let lam: Vec<f64> = block
+        .theta
+        .iter()
+        .map(|&t| op.pencil_eigenvalue(t))
+        .collect();
+    assert_true_eigenvalues(&lam, &exact, 1e-9);
+    // at the cap the block kernel runs: another path, the same eigenvalues
+    let at = LanczosKernel { block: 8 }
+        .largest(&op, BLOCK_MAX_NEV, 1e-10, 300)
+        .unwrap();
+    let at_single = LanczosKernel::SINGLE
+        .largest(&op, BLOCK_MAX_NEV, 1e-10, 300)
+        .unwrap();
+    assert!(at.all_converged);
+    assert_ne!(at.theta, at_single.theta);
+    let lam: Vec<f64> = at.theta.iter().map(|&t| op.pencil_eigenvalue(t)).collect();
+    assert_true_eigenvalues(&lam, &exact, 1e-9);
+}

@@ -21,7 +21,7 @@ use crate::mu_sweep::{
 };
 use crate::outdir::{self, RunError};
 use crate::pipeline::{Method, Prepared, MODAL_SOLVER};
-use crate::profile::{peak_rss_mb, Profile};
+use crate::profile::{peak_rss_mb, take_peak_rss_mb, Profile};
 use crate::reference::paper;
 use serde::Serialize;
 use squeal_contact::LoadedEquilibrium;
@@ -197,8 +197,9 @@ pub fn run(
     // the sub-stages of each sweep, listed after the stages
     let mut detail = Profile::new();
     let mut lap = Instant::now();
+    // each stage's own peak memory: the mark is reset at every stage's end
     let mut stage = |name: &str, lap: &mut Instant| {
-        profile.add(name, lap.elapsed().as_secs_f64());
+        profile.add_with_peak(name, lap.elapsed().as_secs_f64(), take_peak_rss_mb());
         *lap = Instant::now();
     };
     let band = s.band_hz.unwrap_or(scene.study.band_hz);
@@ -295,6 +296,10 @@ pub fn run(
     stage("full-order references", &mut lap);
 
     // 6. report
+    let peak = match (profile.peak_rss_mb(), peak_rss_mb()) {
+        (Some(a), Some(b)) => Some(a.max(b)),
+        (a, b) => a.or(b),
+    };
     let v = Validation {
         file: file.to_string(),
         disc,
@@ -314,7 +319,7 @@ pub fn run(
         eigen: s.eigen.clone(),
         profile,
         detail,
-        peak_rss_mb: peak_rss_mb(),
+        peak_rss_mb: peak,
         time_s: start.elapsed().as_secs_f64(),
     };
     outdir::write(&out.join("report.md"), v.markdown())?;
