@@ -49,8 +49,9 @@ impl Validation {
         );
         let _ = writeln!(
             md,
-            "## 1. Disc modes (free friction face) vs Table 2\n\n{} DOFs, `arpack` {:.1} s. {} of {} labels found, {} within 5 %, {} within 10 %.\n\n```\n{}```\n",
+            "## 1. Disc modes (free friction face) vs Table 2\n\n{} DOFs, `{}` {:.1} s. {} of {} labels found, {} within 5 %, {} within 10 %.\n\n```\n{}```\n",
             self.disc.dofs,
+            self.disc.solver,
             self.disc.solve_time_s,
             self.table2.iter().filter(|r| r.squeal_hz.is_some()).count(),
             self.table2.len(),
