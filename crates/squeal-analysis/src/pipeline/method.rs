@@ -250,6 +250,9 @@ impl Method {
         let mut setup = 0.0;
         self.last = StepTimes::default();
         if stale {
+            // the stale basis goes before the new one is built: both at once would be the
+            // largest allocation of a sweep twice
+            self.cached = None;
             let t = Instant::now();
             let req = squeal_core::contact::BasisRequest {
                 op,

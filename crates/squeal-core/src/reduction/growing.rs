@@ -23,10 +23,16 @@ pub struct GrowingBasis<'a> {
     cv: Option<Mat<f64>>,
 }
 
-/// `a <- [a | b]`, the column capacity of `a` grown in powers of two.
+/// Room for `more` columns after the ones of `a`, the column capacity grown in powers of
+/// two: a matrix extended many times is reallocated only when it doubles.
+fn reserve_doubling(a: &mut Mat<f64>, more: usize) {
+    a.reserve(a.nrows(), (a.ncols() + more).next_power_of_two());
+}
+
+/// `a <- [a | b]` ([`reserve_doubling`]).
 fn append(a: &mut Mat<f64>, b: MatRef<'_, f64>) {
     let (n, m) = (a.nrows(), a.ncols());
-    a.reserve(n, (m + b.ncols()).next_power_of_two());
+    reserve_doubling(a, b.ncols());
     a.resize_with(n, m + b.ncols(), |_, _| 0.0);
     a.as_mut().subcols_mut(m, b.ncols()).copy_from(b);
 }
@@ -73,6 +79,8 @@ impl<'a> GrowingBasis<'a> {
     pub fn extend(&mut self, new: MatRef<'_, f64>, rank_tol: f64) -> Result<usize> {
         let mc = self.op.mc.as_ref();
         let before = self.len();
+        reserve_doubling(&mut self.v, new.ncols());
+        reserve_doubling(&mut self.mv, new.ncols());
         let dropped = m_orthonormal_extend_in_place(mc, &mut self.v, &mut self.mv, new, rank_tol)?;
         let w = self.v.as_ref().subcols(before, self.len() - before);
         if w.ncols() > 0 {

@@ -103,8 +103,9 @@ pub fn m_orthonormal_extend_imaged(
 
 /// [`m_orthonormal_extend_imaged`] in place: the `M`-orthonormal columns `v` and their
 /// images `mv = M v` grow by the kept directions of `new` (their images carried through
-/// the projections). The column capacity grows geometrically, so a basis extended many
-/// times is not copied each time. Returns the number of columns of `new` dropped.
+/// the projections). Columns are reserved for every column of `new` unless `v` and `mv`
+/// already have the room (a caller that extends many times reserves ahead, so its basis
+/// is not copied each time). Returns the number of columns of `new` dropped.
 pub(crate) fn m_orthonormal_extend_in_place(
     m: SparseRef<'_>,
     v: &mut Mat<f64>,
@@ -129,8 +130,7 @@ pub(crate) fn m_orthonormal_extend_in_place(
     let cap = k + new.ncols();
     let grown = |a: &mut Mat<f64>| {
         let mut a = std::mem::replace(a, Mat::new());
-        // capacity in powers of two: reallocated only when the basis doubles
-        a.reserve(n, cap.next_power_of_two());
+        a.reserve(n, cap);
         a.resize_with(n, cap, |_, _| 0.0);
         a
     };
