@@ -41,7 +41,7 @@ impl Factor<'_> {
 pub struct ShiftInvert<'a> {
     m: SparseRef<'a>,
     sigma: f64,
-    llt: Factor<'a>,
+    factor: Factor<'a>,
     applications: std::sync::atomic::AtomicUsize,
 }
 
@@ -67,7 +67,7 @@ impl<'a> ShiftInvert<'a> {
         Ok(Self {
             m,
             sigma,
-            llt: Factor::Owned {
+            factor: Factor::Owned {
                 llt: Box::new(llt),
                 shifted,
             },
@@ -88,7 +88,7 @@ impl<'a> ShiftInvert<'a> {
         Self {
             m,
             sigma,
-            llt: Factor::Borrowed {
+            factor: Factor::Borrowed {
                 llt: factor.llt(),
                 shifted,
             },
@@ -98,7 +98,7 @@ impl<'a> ShiftInvert<'a> {
 
     /// The shifted matrix `K - sigma M`.
     pub fn shifted(&self) -> SparseRef<'_> {
-        self.llt.shifted()
+        self.factor.shifted()
     }
 
     /// The mass matrix.
@@ -115,7 +115,7 @@ impl<'a> ShiftInvert<'a> {
     pub fn solve_in_place(&self, y: &mut [f64]) {
         let n = y.len();
         let mat = MatMut::from_column_major_slice_mut(y, n, 1);
-        self.llt.llt().solve_in_place(mat);
+        self.factor.llt().solve_in_place(mat);
     }
 
     /// `Y <- (K - sigma M)^-1 Y` for a block of columns, each counted as one application
@@ -123,7 +123,7 @@ impl<'a> ShiftInvert<'a> {
     /// what makes block Krylov methods cheaper per column on large factors.
     pub fn solve_block_in_place(&self, mut y: MatMut<'_, f64>) {
         let cols = y.ncols();
-        self.llt.llt().solve_in_place(y.as_mut());
+        self.factor.llt().solve_in_place(y.as_mut());
         self.applications
             .fetch_add(cols, std::sync::atomic::Ordering::Relaxed);
     }
