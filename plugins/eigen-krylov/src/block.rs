@@ -421,6 +421,20 @@ pub(crate) fn fits(n: usize, nev: usize, b: usize) -> bool {
     capacity(nev, b) + 2 * b <= n
 }
 
+/// Restarts in a row without progress after which the block kernel gives up
+/// ([`largest_block`]): no more wanted pairs converged and the largest relative residual
+/// estimate among them not halved.
+pub(crate) const STALL_RESTARTS: usize = 4;
+
+/// What [`largest_block`] ends with.
+pub(crate) enum BlockOutcome {
+    /// The pairs (all, or those that passed the test when `max_restarts` was hit).
+    Done(KernelOutput),
+    /// [`STALL_RESTARTS`] restarts in a row made no progress (after `restarts`): the
+    /// caller takes another method.
+    Stalled { restarts: usize },
+}
+
 /// The `nev` largest eigenpairs of `OP` by block thick-restart Lanczos with blocks of
 /// `block` columns (module docs). `max_restarts` caps the restarts; when it is hit the
 /// pairs that passed the test are returned with `all_converged = false`.
@@ -430,7 +444,7 @@ pub(crate) fn largest_block(
     tol: f64,
     max_restarts: usize,
     block: usize,
-) -> Result<KernelOutput> {
+) -> Result<BlockOutcome> {
     let n = op.dim();
     let nev = nev.min(n);
     let b = block.max(1);
@@ -468,6 +482,8 @@ pub(crate) fn largest_block(
     // the new blocks is below the tolerance and is kept at zero (its recomputed value is
     // the block solves' error, which would otherwise undo their convergence)
     let mut locked = 0;
+    // (most wanted pairs converged, smallest largest relative residual, at which restart)
+    let mut progress = (0usize, f64::INFINITY, 0usize);
     loop {
         // expand the last block: W = OP V_l = (K - sigma M)^-1 (M V_l)
         let mut w = s.mv.as_ref().subcols(last, s.m - last).to_owned();
@@ -504,17 +520,32 @@ pub(crate) fn largest_block(
             let vectors = times(s.v.as_ref().subcols(0, m), ysel.as_ref());
             let theta: Vec<f64> = keep.iter().map(|&i| theta[i]).collect();
             let (theta, vectors) = purify(op, &theta, vectors, tol)?;
-            return Ok(KernelOutput {
+            return Ok(BlockOutcome::Done(KernelOutput {
                 theta,
                 vectors,
                 iterations: restarts,
                 all_converged: done,
-            });
+            }));
         }
         if s.m + b <= cap {
             last = s.m;
             s.append(&q, &mq);
             continue;
+        }
+        // progress since the last restart that made some, else give up after a few
+        let converged_now = want.iter().filter(|&&i| converged(i)).count();
+        let worst = want
+            .iter()
+            .map(|&i| residual(i) / theta[i].abs())
+            .fold(0.0f64, f64::max);
+        if converged_now > progress.0 || worst <= 0.5 * progress.1 {
+            progress = (
+                converged_now.max(progress.0),
+                worst.min(progress.1),
+                restarts,
+            );
+        } else if restarts - progress.2 >= STALL_RESTARTS {
+            return Ok(BlockOutcome::Stalled { restarts });
         }
         // thick restart: keep the k largest Ritz pairs, Q becomes the next block
         restarts += 1;

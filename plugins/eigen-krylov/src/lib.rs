@@ -209,7 +209,9 @@ pub const DEFAULT_BLOCK: usize = 8;
 /// repeated eigenvalues; with `block > 1` on blocks of that many columns (module
 /// `block`), which holds up to `block` copies of a repeated eigenvalue and reads the
 /// factor of `K - sigma M` once per block. Problems too small for the block basis, and
-/// calls for more than [`BLOCK_MAX_NEV`] pairs, take the single-vector path.
+/// calls for more than [`BLOCK_MAX_NEV`] pairs, take the single-vector path; so does a
+/// block run that makes no progress for `block::STALL_RESTARTS` restarts in a row (the
+/// single-vector kernel then starts afresh with the restarts left).
 #[derive(Debug, Clone, Copy)]
 pub struct LanczosKernel {
     /// Columns per application of `OP` (1: single-vector Lanczos).
@@ -237,11 +239,18 @@ impl SymmetricKernel for LanczosKernel {
             ));
         }
         let bs = self.block;
+        let mut spent = 0;
         if bs > 1 && nev <= BLOCK_MAX_NEV && block::fits(n, nev, bs) {
-            return block::largest_block(op, nev, tol, max_restarts, bs);
+            match block::largest_block(op, nev, tol, max_restarts, bs)? {
+                block::BlockOutcome::Done(out) => return Ok(out),
+                // the single-vector kernel takes over with the restarts left
+                block::BlockOutcome::Stalled { restarts } => spent = restarts,
+            }
         }
         let start: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
-        largest_from(op, nev, tol, max_restarts, start)
+        let mut out = largest_from(op, nev, tol, max_restarts.saturating_sub(spent), start)?;
+        out.iterations += spent;
+        Ok(out)
     }
 }
 
