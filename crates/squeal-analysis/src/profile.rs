@@ -56,10 +56,7 @@ impl Profile {
             Some(s) => {
                 s.time_s += time_s;
                 s.count += count;
-                s.peak_rss_mb = match (s.peak_rss_mb, peak) {
-                    (Some(a), Some(b)) => Some(a.max(b)),
-                    (a, b) => a.or(b),
-                };
+                s.peak_rss_mb = max_opt(s.peak_rss_mb, peak);
             }
             None => self.stages.push(StageTime {
                 stage: stage.to_string(),
@@ -121,6 +118,15 @@ impl Profile {
             md.push('\n');
         }
         md
+    }
+}
+
+/// The larger of two optional measurements (either one when the other is missing).
+pub fn max_opt(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    match (a, b) {
+        (Some(x), Some(y)) => Some(x.max(y)),
+        (x, None) => x,
+        (None, y) => y,
     }
 }
 

@@ -49,9 +49,10 @@
 //! Start block: deterministic pseudo-random columns, so results are reproducible.
 
 use super::{par_for, Directions, BREAKDOWN};
-use squeal_core::eigen::KernelOutput;
+use squeal_core::eigen::{dense_symmetric_pencil, KernelOutput};
 use squeal_core::faer::linalg::matmul::matmul;
-use squeal_core::faer::{Accum, Mat, MatMut, MatRef, Side};
+use squeal_core::faer::linalg::triangular_solve::solve_upper_triangular_in_place;
+use squeal_core::faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 use squeal_core::linalg::{dot, sparse_transpose_times};
 use squeal_core::spectral::{LinOp, ShiftInvert};
 use squeal_core::{Error, Result};
@@ -109,17 +110,8 @@ fn chol_qr(w: &Mat<f64>, mw: &Mat<f64>, removed: &[f64]) -> Option<(Mat<f64>, Ma
             return None;
         }
     }
-    // R^-1 by back substitution (b x b, upper triangular)
-    let mut rinv = Mat::<f64>::zeros(b, b);
-    for c in 0..b {
-        for i in (0..=c).rev() {
-            let mut sum = if i == c { 1.0 } else { 0.0 };
-            for k in i + 1..=c {
-                sum -= r[(i, k)] * rinv[(k, c)];
-            }
-            rinv[(i, c)] = sum / r[(i, i)];
-        }
-    }
+    let mut rinv = Mat::<f64>::identity(b, b);
+    solve_upper_triangular_in_place(r.as_ref(), rinv.as_mut(), Par::Seq);
     Some((
         times(w.as_ref(), rinv.as_ref()),
         times(mw.as_ref(), rinv.as_ref()),
@@ -368,35 +360,17 @@ fn purify(
     tmul_into(gm.as_mut(), Accum::Replace, w.as_ref(), mw.as_ref());
     let gm = Mat::from_fn(p, p, |i, j| 0.5 * (gm[(i, j)] + gm[(j, i)]));
     let ga = Mat::from_fn(p, p, |i, j| 0.5 * (ga[(i, j)] + ga[(j, i)]));
-    let l = gm
-        .llt(Side::Lower)
-        .map_err(|e| Error::Invalid(format!("krylov: purification mass: {e:?}")))?;
-    // C = L^-1 Ga L^-T
-    let lo = l.L().to_owned();
-    let mut linv = Mat::<f64>::zeros(p, p);
-    for c in 0..p {
-        for i in c..p {
-            let mut sum = if i == c { 1.0 } else { 0.0 };
-            for q in c..i {
-                sum -= lo[(i, q)] * linv[(q, c)];
-            }
-            linv[(i, c)] = sum / lo[(i, i)];
-        }
-    }
-    let c = times(times(linv.as_ref(), ga.as_ref()).as_ref(), linv.transpose());
-    let c = Mat::from_fn(p, p, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
-    let ce = c
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::Invalid(format!("krylov: purification: {e:?}")))?;
+    // the pencil (Ga, Gm): eigenvalues lambda - sigma = 1 / theta, Gm-orthonormal vectors
+    let (shifted, y) = dense_symmetric_pencil(ga.as_ref(), gm.as_ref())
+        .map_err(|e| Error::Invalid(format!("krylov: purification: {e}")))?;
     // each input pair takes the Ritz vector that overlaps it most (W's first k columns are
     // X, so the overlaps are Y^T Gm[.., ..k]), so the step refines the pairs it was given
-    let y = times(linv.transpose(), ce.U());
     let overlap = times(y.transpose(), gm.as_ref().subcols(0, k));
     let mut used = vec![false; p];
     let mut pick = Vec::with_capacity(k);
     for j in 0..k {
         let best = (0..p)
-            .filter(|&i| !used[i] && ce.S()[i] > 0.0)
+            .filter(|&i| !used[i] && shifted[i] > 0.0)
             .max_by(|&a, &b| overlap[(a, j)].abs().total_cmp(&overlap[(b, j)].abs()));
         match best {
             Some(i) => {
@@ -408,7 +382,7 @@ fn purify(
     }
     let ysel = Mat::from_fn(p, k, |i, j| y[(i, pick[j])]);
     let xn = times(w.as_ref(), ysel.as_ref());
-    Ok((pick.iter().map(|&i| 1.0 / ce.S()[i]).collect(), xn))
+    Ok((pick.iter().map(|&i| 1.0 / shifted[i]).collect(), xn))
 }
 
 /// Relative size (to `theta`) of a residual `OP x - theta x` below which the purification

@@ -530,15 +530,21 @@ fn twin_chains(half: usize) -> (SparseMat, SparseMat) {
     (sparse(2 * half, &kt), sparse(2 * half, &mt))
 }
 
-#[test]
-fn block_kernel_finds_doublets_and_matches_the_dense_oracle() {
-    let (k, m) = twin_chains(200);
+/// [`twin_chains`] and their whole spectrum by the dense oracle, ascending.
+fn twin_chains_and_spectrum(half: usize) -> (SparseMat, SparseMat, Vec<f64>) {
+    let (k, m) = twin_chains(half);
     let problem = SymmetricProblem {
         k: k.as_ref(),
         m: m.as_ref(),
     };
     let (mut dense, _) = dense_symmetric(&problem).unwrap();
     dense.sort_by(f64::total_cmp);
+    (k, m, dense)
+}
+
+#[test]
+fn block_kernel_finds_doublets_and_matches_the_dense_oracle() {
+    let (k, m, dense) = twin_chains_and_spectrum(200);
     let sigma = -0.1 * dense[0];
     let op = ShiftInvert::new(k.as_ref(), m.as_ref(), sigma).unwrap();
     for block in [2, 5, 8] {
@@ -562,13 +568,7 @@ fn block_kernel_finds_doublets_and_matches_the_dense_oracle() {
 
 #[test]
 fn block_and_single_vector_solvers_agree_through_the_band_driver() {
-    let (k, m) = twin_chains(150);
-    let problem = SymmetricProblem {
-        k: k.as_ref(),
-        m: m.as_ref(),
-    };
-    let (mut dense, _) = dense_symmetric(&problem).unwrap();
-    dense.sort_by(f64::total_cmp);
+    let (k, m, dense) = twin_chains_and_spectrum(150);
     let count = 30;
     let fmax = 0.5 * (hz(dense[count - 1]) + hz(dense[count]));
     let block = solve(&k, &m, &params(fmax));

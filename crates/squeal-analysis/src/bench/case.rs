@@ -4,6 +4,7 @@
 use super::{compare, BenchOptions, MemoryProbe, ModeErrors, Stages};
 use crate::jsonl::{nan, null_as_nan};
 use crate::pipeline::{PipelineError, Result};
+use crate::profile::max_opt;
 use serde::{Deserialize, Serialize};
 use squeal_core::contact::BasisRequest;
 use squeal_core::operator::ComplexModes;
@@ -113,14 +114,6 @@ impl<'a> Meter<'a> {
             p.reset();
             peak
         })
-    }
-}
-
-fn max_opt(a: Option<f64>, b: Option<f64>) -> Option<f64> {
-    match (a, b) {
-        (Some(x), Some(y)) => Some(x.max(y)),
-        (x, None) => x,
-        (None, y) => y,
     }
 }
 

@@ -21,7 +21,7 @@ use crate::mu_sweep::{
 };
 use crate::outdir::{self, RunError};
 use crate::pipeline::{Method, Prepared, MODAL_SOLVER};
-use crate::profile::{peak_rss_mb, take_peak_rss_mb, Profile};
+use crate::profile::{max_opt, peak_rss_mb, take_peak_rss_mb, Profile};
 use crate::reference::paper;
 use serde::Serialize;
 use squeal_contact::LoadedEquilibrium;
@@ -296,10 +296,7 @@ pub fn run(
     stage("full-order references", &mut lap);
 
     // 6. report
-    let peak = match (profile.peak_rss_mb(), peak_rss_mb()) {
-        (Some(a), Some(b)) => Some(a.max(b)),
-        (a, b) => a.or(b),
-    };
+    let peak = max_opt(profile.peak_rss_mb(), peak_rss_mb());
     let v = Validation {
         file: file.to_string(),
         disc,

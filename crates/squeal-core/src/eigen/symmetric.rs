@@ -7,7 +7,7 @@ use crate::linalg::{col, dot, norm1, norm2, sparse_transpose_times};
 use crate::operator::{RealModes, SolveInfo, StopReason};
 use crate::spectral::{LinOp, ShiftInvert, SpectralTransform};
 use crate::{Error, Result, SparseRef};
-use faer::Mat;
+use faer::{Mat, MatRef};
 use std::time::Instant;
 
 /// `K x = omega^2 M x` on the free DOFs.
@@ -237,16 +237,23 @@ pub fn finish_real_modes(
 /// Dense solution of the whole symmetric pencil (small problems and oracles):
 /// `M = L L^T`, `L^-1 K L^-T y = lambda y`, `x = L^-T y`.
 pub fn dense_symmetric(problem: &SymmetricProblem<'_>) -> Result<(Vec<f64>, Mat<f64>)> {
-    let n = problem.k.nrows();
-    let k = problem.k.to_dense();
-    let m = problem.m.to_dense();
+    dense_symmetric_pencil(problem.k.to_dense().as_ref(), problem.m.to_dense().as_ref())
+}
+
+/// [`dense_symmetric`] of a dense pencil `(K, M)` (a Rayleigh-Ritz step's projected
+/// matrices): eigenvalues ascending, eigenvectors `M`-orthonormal.
+pub fn dense_symmetric_pencil(
+    k: MatRef<'_, f64>,
+    m: MatRef<'_, f64>,
+) -> Result<(Vec<f64>, Mat<f64>)> {
+    let n = k.nrows();
     let llt = m.llt(faer::Side::Lower).map_err(|e| Error::Factorization {
         what: "M (dense)".into(),
         reason: format!("{e:?}: the mass matrix must be positive definite"),
     })?;
     let l = llt.L().to_owned();
     // A = L^-1 K L^-T
-    let mut a = k.clone();
+    let mut a = k.to_owned();
     faer::linalg::triangular_solve::solve_lower_triangular_in_place(
         l.as_ref(),
         a.as_mut(),
