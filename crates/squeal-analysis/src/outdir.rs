@@ -137,7 +137,11 @@ pub fn claim(out: &Path, command: &str) -> Result<(), RunError> {
             "holds the output of `squeal {o}`; choose another directory for `squeal {command}`"
         )));
     }
-    let v = serde_json::json!({ "command": command, "squeal": env!("CARGO_PKG_VERSION") });
+    let v = serde_json::json!({
+        "command": command,
+        "squeal": env!("CARGO_PKG_VERSION"),
+        "machine": crate::profile::Machine::here(),
+    });
     let text = serde_json::to_string_pretty(&v).unwrap_or_default() + "\n";
     std::fs::write(&marker, text).map_err(|e| dir(format!("cannot write {OUTPUT_MARKER} ({e})")))
 }
@@ -152,6 +156,15 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
         claim(&dir, "validate").unwrap();
         claim(&dir, "validate").unwrap();
+        // the marker names the machine the run's times come from
+        let marker: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(OUTPUT_MARKER)).unwrap())
+                .unwrap();
+        assert!(
+            marker["machine"]["cores"].as_u64().unwrap() >= 1,
+            "{marker}"
+        );
+        assert!(marker["machine"]["cpu"].is_string(), "{marker}");
         let e = claim(&dir, "bench").unwrap_err().to_string();
         assert!(e.contains("holds the output of `squeal validate`"), "{e}");
         let file = dir.join("a-file");

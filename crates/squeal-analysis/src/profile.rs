@@ -1,8 +1,8 @@
 //! Where the time of a run goes: named stages with their wall time, how many times each
 //! ran and, where the run measured it, the peak resident memory while it ran
 //! ([`Profile`]); the process's peak resident memory ([`peak_rss_mb`]) and the peak since
-//! the last stage ([`take_peak_rss_mb`]). Every report (`validate`, sweeps, studies,
-//! bench) carries one.
+//! the last stage ([`take_peak_rss_mb`]); the machine a run measured its times on
+//! ([`Machine`]). Every report (`validate`, sweeps, studies, bench) carries one.
 
 use serde::{Deserialize, Serialize};
 use std::fmt::Write;
@@ -121,6 +121,66 @@ impl Profile {
     }
 }
 
+/// The machine a run's times were measured on: the same code on another processor of the
+/// same core count can take twice as long, so every timed report names it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Machine {
+    /// Processor model (`model name` of `/proc/cpuinfo`; `unknown` where it is not given).
+    pub cpu: String,
+    /// Cores the run may use.
+    pub cores: usize,
+    /// Physical memory (GiB), where known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub memory_gib: Option<f64>,
+}
+
+impl Machine {
+    /// The machine this process runs on.
+    pub fn here() -> Self {
+        let cpu = std::fs::read_to_string("/proc/cpuinfo")
+            .ok()
+            .and_then(|t| cpuinfo_model(&t))
+            .unwrap_or_else(|| "unknown".into());
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let memory_gib = std::fs::read_to_string("/proc/meminfo")
+            .ok()
+            .and_then(|t| meminfo_kib(&t, "MemTotal:"))
+            .map(|kib| kib / (1024.0 * 1024.0));
+        Self {
+            cpu,
+            cores,
+            memory_gib,
+        }
+    }
+}
+
+impl std::fmt::Display for Machine {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}, {} cores", self.cpu, self.cores)?;
+        if let Some(g) = self.memory_gib {
+            write!(f, ", {g:.0} GiB")?;
+        }
+        Ok(())
+    }
+}
+
+/// The first `model name` of a `/proc/cpuinfo` text.
+fn cpuinfo_model(text: &str) -> Option<String> {
+    let line = text.lines().find(|l| l.starts_with("model name"))?;
+    let name = line
+        .split_once(':')?
+        .1
+        .split_whitespace()
+        .collect::<Vec<_>>();
+    (!name.is_empty()).then(|| name.join(" "))
+}
+
+/// The value (kB) of `key` in a `/proc/meminfo` text.
+fn meminfo_kib(text: &str, key: &str) -> Option<f64> {
+    let line = text.lines().find(|l| l.starts_with(key))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
+
 /// The larger of two optional measurements (either one when the other is missing).
 pub fn max_opt(a: Option<f64>, b: Option<f64>) -> Option<f64> {
     match (a, b) {
@@ -171,6 +231,22 @@ mod tests {
         assert_eq!(q.stages[1].stage, "sweep: solve");
         let md = p.markdown(12.0);
         assert!(md.contains("| basis | 2 | 5.0 | 42 % |"), "{md}");
+    }
+
+    #[test]
+    fn the_machine_is_read_from_proc_texts() {
+        let cpuinfo = "processor\t: 0\nvendor_id\t: AuthenticAMD\nmodel name\t: AMD  EPYC 9B14\n";
+        assert_eq!(cpuinfo_model(cpuinfo).as_deref(), Some("AMD EPYC 9B14"));
+        assert_eq!(cpuinfo_model("processor\t: 0\n"), None);
+        let meminfo = "MemTotal:       25165824 kB\nMemFree:  1 kB\n";
+        assert_eq!(meminfo_kib(meminfo, "MemTotal:"), Some(25_165_824.0));
+        let m = Machine {
+            cpu: "AMD EPYC 9B14".into(),
+            cores: 2,
+            memory_gib: Some(24.0),
+        };
+        assert_eq!(m.to_string(), "AMD EPYC 9B14, 2 cores, 24 GiB");
+        assert!(Machine::here().cores >= 1);
     }
 
     #[test]

@@ -21,7 +21,7 @@ use crate::mu_sweep::{
 };
 use crate::outdir::{self, RunError};
 use crate::pipeline::{Method, Prepared, MODAL_SOLVER};
-use crate::profile::{max_opt, peak_rss_mb, take_peak_rss_mb, Profile};
+use crate::profile::{max_opt, peak_rss_mb, take_peak_rss_mb, Machine, Profile};
 use crate::reference::paper;
 use serde::Serialize;
 use squeal_contact::LoadedEquilibrium;
@@ -139,6 +139,8 @@ pub struct Validation {
     pub peak_rss_mb: Option<f64>,
     /// Wall time (s).
     pub time_s: f64,
+    /// The machine the times were measured on.
+    pub machine: Machine,
 }
 
 /// Band top of the disc's modes against Table 2 (Hz).
@@ -318,6 +320,7 @@ pub fn run(
         detail,
         peak_rss_mb: peak,
         time_s: start.elapsed().as_secs_f64(),
+        machine: Machine::here(),
     };
     outdir::write(&out.join("report.md"), v.markdown())?;
     outdir::write_json(&out.join("report.json"), &v.json())?;

@@ -101,8 +101,9 @@ impl Validation {
         let total = self.time_s;
         let _ = writeln!(
             md,
-            "## 6. Paper vs squeal\n\n```\n{}```\n\n## Where the time went\n\n{}| total | | {total:.1} | |\n\nInside the sweeps (points read back from a checkpoint excluded):\n\n{}\nPeak resident memory: {}.",
+            "## 6. Paper vs squeal\n\n```\n{}```\n\n## Where the time went\n\nMachine: {}.\n\n{}| total | | {total:.1} | |\n\nInside the sweeps (points read back from a checkpoint excluded):\n\n{}\nPeak resident memory: {}.",
             self.paper_table(),
+            self.machine,
             self.profile.markdown(total),
             self.detail.markdown(total),
             self.peak_rss_mb
@@ -184,6 +185,7 @@ impl Validation {
             "sweep_stages": self.detail.stages,
             "peak_rss_mb": self.peak_rss_mb,
             "time_s": self.time_s,
+            "machine": self.machine,
         })
     }
 }
