@@ -9,7 +9,9 @@
 #   calibrate-disc  the disc fitted to Table 2
 #   macro           macroscopic zones at mu 0.36 and 0.43: centred a-sweep (b = 14.2 mm) and
 #                   off-centre zones
-#   meso-c2         mesoscopic plateaus in the coupling-2 region (0.2 mm grid)
+#   meso-c2         mesoscopic plateaus in the coupling-2 region (0.2 mm grid), 70 % of the
+#                   patches in contact
+#   meso-c2-f0.5    the same with 50 % of the patches in contact
 #   meso-c1         mesoscopic plateaus in the coupling-1 region (0.5 mm grid)
 #   fraction        the unstable share against the fraction of patches in contact, both
 #                   couplings, one patch size each (1 mm and 2 mm), 10 layouts per fraction
@@ -47,6 +49,10 @@ case "$name" in
     [ -d out/meso-c2 ] && resume=(--resume)
     $squeal sweep meso scenes/pin-on-disc-meso.toml --coupling 2 --basis cms --jobs 2 \
       --out out/meso-c2 "${resume[@]}" "$@" ;;
+  meso-c2-f0.5)
+    [ -d out/meso-c2-f0.5 ] && resume=(--resume)
+    $squeal sweep meso scenes/pin-on-disc-meso.toml --coupling 2 --basis cms --jobs 2 \
+      --fraction 0.5 --out out/meso-c2-f0.5 "${resume[@]}" "$@" ;;
   meso-c1)
     [ -d out/meso-c1 ] && resume=(--resume)
     $squeal sweep meso scenes/pin-on-disc-meso-c1.toml --coupling 1 --basis cms --jobs 2 \
@@ -69,6 +75,6 @@ case "$name" in
   stress)
     $squeal bench pin-on-disc --stress --vary none --out out/stress "$@" ;;
   *)
-    sed -n '2,18p' "$0"
+    sed -n '2,21p' "$0"
     exit 2 ;;
 esac

@@ -233,7 +233,7 @@ impl ReductionBasis for PodBasis {
                 modes.len(),
                 params.fmin_hz,
                 params.fmax_hz,
-                request.modal.name()
+                modes.info.solver
             ));
             snapshots.push(modes);
         }
