@@ -112,7 +112,8 @@ pub struct StepTimes {
 impl Method {
     /// `basis = "none"` for full order; `basis_params` go to the basis plugin; `modal` is
     /// the sparse symmetric solver a basis uses for its real modes (the full-order complex
-    /// problems a basis solves go to [`COMPLEX_SOLVER`]: [`ModalSolvers`]).
+    /// problems a basis solves go to [`COMPLEX_SOLVER`] when registered:
+    /// [`ModalSolvers::of`]).
     pub fn new(
         registry: &Registry,
         basis: &str,
@@ -139,20 +140,7 @@ impl Method {
                 .eigen
                 .create(eigen, &Params::new())
                 .map_err(core("eigen solver"))?,
-            modal: Arc::new(ModalSolvers::new(
-                Arc::from(
-                    registry
-                        .eigen
-                        .create(modal, &Params::new())
-                        .map_err(core("modal eigen solver"))?,
-                ),
-                Arc::from(
-                    registry
-                        .eigen
-                        .create(COMPLEX_SOLVER, &Params::new())
-                        .map_err(core("complex eigen solver of the bases"))?,
-                ),
-            )),
+            modal: ModalSolvers::of(registry, modal).map_err(core("modal eigen solver"))?,
             params,
             cached: None,
             stage: None,

@@ -4,7 +4,7 @@
 use squeal_core::eigen::SymmetricProblem;
 use squeal_core::operator::{ComplexModes, Qep, RealModes};
 use squeal_core::spectral::ShiftInvert;
-use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Result};
+use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Params, Registry, Result};
 use std::sync::Arc;
 
 /// The real-mode problems of a basis (its tied real modes, a model stage's free modes) go
@@ -21,6 +21,18 @@ impl ModalSolvers {
     /// Real-mode problems to `real`, complex ones to `complex`.
     pub fn new(real: Arc<dyn EigenSolver>, complex: Arc<dyn EigenSolver>) -> Self {
         Self { real, complex }
+    }
+
+    /// The registered solver `real` for the real-mode problems and
+    /// [`super::COMPLEX_SOLVER`] for the complex ones; `real` for both when the registry
+    /// has no [`super::COMPLEX_SOLVER`] (a registry assembled without it).
+    pub fn of(registry: &Registry, real: &str) -> Result<Arc<dyn EigenSolver>> {
+        let real: Arc<dyn EigenSolver> = Arc::from(registry.eigen.create(real, &Params::new())?);
+        let complex = match registry.eigen.create(super::COMPLEX_SOLVER, &Params::new()) {
+            Ok(c) => Arc::from(c),
+            Err(_) => real.clone(),
+        };
+        Ok(Arc::new(Self::new(real, complex)))
     }
 }
 
@@ -79,6 +91,29 @@ mod tests {
         fn solve_qep(&self, _: &Qep, _: &EigenParams) -> Result<ComplexModes> {
             Err(Error::Invalid(format!("{}: complex", self.0)))
         }
+    }
+
+    #[test]
+    fn without_the_complex_solver_the_modal_solver_solves_both() {
+        let mut reg = Registry::default();
+        reg.eigen.register("lanczos", "stub", |_: &Params| {
+            let s: Box<dyn EigenSolver> = Box::new(Named("lanczos"));
+            Ok(s)
+        });
+        let split = ModalSolvers::of(&reg, "lanczos").unwrap();
+        let eye = SparseMat::try_new_from_triplets(1, 1, &[Triplet::new(0, 0, 1.0)]).unwrap();
+        let qep = Qep {
+            m: eye.clone(),
+            c: None,
+            k: eye,
+        };
+        let e = split
+            .solve_qep(&qep, &EigenParams::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("lanczos: complex"), "{e}");
+        // an unknown modal solver is still refused
+        assert!(ModalSolvers::of(&reg, "nonesuch").is_err());
     }
 
     #[test]
