@@ -29,8 +29,8 @@ pub struct ValidateArgs {
     /// Further bases swept as checks, comma separated (the paper's two; `none`: no check).
     #[arg(long, value_delimiter = ',', default_value = "enriched,residue")]
     bases: Vec<String>,
-    /// Step of the check sweeps.
-    #[arg(long, default_value = "0.1")]
+    /// Step of the check sweeps (0.05 puts points inside both couplings' windows).
+    #[arg(long, default_value = "0.05")]
     check_step: f64,
     /// Frequency band `FMIN:FMAX` (Hz) of the sweeps and reference points; default: the
     /// scene's `study.band_hz`.

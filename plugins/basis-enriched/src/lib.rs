@@ -6,9 +6,12 @@
 //! vector per active pair), optionally compressed by an SVD in the `M_c` inner product.
 //! Everything is `M_c`-orthonormalized with the rank cut of
 //! [`squeal_core::reduction`] (columns scaled to unit `M_c` norm first, so the static
-//! vectors, of order 1e-9 m per N, survive next to unit-modal-mass modes). One sparse
-//! Cholesky factorization of `K_c` serves the modes (shift-invert at 0) and the static
-//! responses; the basis's note gives the time of each step.
+//! vectors, of order 1e-9 m per N, survive next to unit-modal-mass modes). The solves
+//! with `K_c` serve the modes (shift-invert at 0) and the static responses; they go
+//! through the free model's factor and the Schur complement on the contact set's pairs
+//! (the model stage [`PairSolves`], built once per model, shared with `residue`), or
+//! through a sparse Cholesky factorization of `K_c` when there is no stage (an operator
+//! read from files). The basis's note says which and gives the time of each step.
 //!
 //! Fixed in mu, not in contact set: built once per contact set (a new active set means
 //! a new `T` and a new basis) and reused across a whole mu sweep
@@ -26,9 +29,11 @@ use squeal_core::linalg::norm2;
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
     coupled_real_modes_on, friction_load_directions, m_orthonormal_extend, m_orthonormalize,
-    m_svd_compress, StaticSolver, DEFAULT_RANK_TOL,
+    m_svd_compress, PairSolves, StaticSolver, DEFAULT_RANK_TOL, PAIR_SOLVES_STAGE_KEY,
 };
-use squeal_core::{Basis, BasisRequest, Error, Params, ReductionBasis, Registry, Result};
+use squeal_core::{
+    Basis, BasisRequest, Error, FreeModel, ModelStage, Params, ReductionBasis, Registry, Result,
+};
 use std::time::Instant;
 
 /// Name under which the basis is registered.
@@ -87,6 +92,15 @@ impl ReductionBasis for EnrichedBasis {
         NAME
     }
 
+    /// The free model's pair solves: every contact set's `K_c` is solved through them.
+    fn stage_key(&self, _band_top_hz: f64) -> Option<String> {
+        Some(PAIR_SOLVES_STAGE_KEY.into())
+    }
+
+    fn prepare(&self, free: &FreeModel<'_>) -> Result<Option<ModelStage>> {
+        PairSolves::stage(free)
+    }
+
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {
         let op = request.op;
         let mc = op.mc.as_ref();
@@ -95,7 +109,7 @@ impl ReductionBasis for EnrichedBasis {
         // static responses need K_c itself, and it is positive definite when they exist)
         // and the static responses
         let clock = Instant::now();
-        let ks = StaticSolver::new(op, 0.0)?;
+        let mut ks = StaticSolver::tied_or_new(op, PairSolves::in_stage(request.stage), 0.0)?;
         let t_factor = clock.elapsed().as_secs_f64();
         let modes = coupled_real_modes_on(request, cutoff, &ks)?;
         let t_modes = clock.elapsed().as_secs_f64() - t_factor;
@@ -107,6 +121,7 @@ impl ReductionBasis for EnrichedBasis {
         ks.solve_in_place(statics.as_mut());
         let t_statics = clock.elapsed().as_secs_f64();
         // the factor is the largest allocation here: freed before the orthonormalization
+        let method = std::mem::take(&mut ks.method);
         drop(ks);
         let finite = (0..statics.ncols())
             .all(|c| norm2(statics.col(c).try_as_col_major().unwrap().as_slice()).is_finite());
@@ -127,15 +142,16 @@ impl ReductionBasis for EnrichedBasis {
         basis.dropped = dropped_modes + dropped_svd + dropped_static;
         basis.notes.push(format!(
             "{NAME}: {} real modes up to {cutoff:.1} Hz (`{}`) + {} static vectors of {loads} \
-             friction loads ({} removed by the SVD cut{}, {} by the rank cut); times: K_c \
-             factorization {t_factor:.2} s (shared by modes and statics), modes {t_modes:.2} \
-             s, static solves {t_statics:.2} s, orthonormalization {t_orth:.2} s",
+             friction loads ({} removed by the SVD cut{}, {} by the rank cut); {}; times: set-up \
+             {t_factor:.2} s (shared by modes and statics), modes {t_modes:.2} s, static \
+             solves {t_statics:.2} s, orthonormalization {t_orth:.2} s",
             vm.ncols(),
             request.modal.name(),
             basis.len() - vm.ncols(),
             dropped_svd,
             self.svd_tol.map_or(String::new(), |t| format!(" at {t:e}")),
-            dropped_static
+            dropped_static,
+            method
         ));
         Ok(basis)
     }

@@ -9,7 +9,10 @@
 //!    frequency in the band widened by [`TARGET_MARGIN`] on each side;
 //! 2. residual of each target on the FULL operator `r_j = Q(lambda_j) V q_j`, static
 //!    response `d_j = K_s^-1 r_j` with one factorization of `K_s = K_c + shift M_c`
-//!    reused for every iteration (the real modes of the start are computed on it too),
+//!    reused for every iteration (the real modes of the start are computed on it too;
+//!    at shift 0 no factorization: `K_c` is solved through the free model's factor and
+//!    the pairs of the contact set, the model stage
+//!    [`PairSolves`](squeal_core::reduction::PairSolves) shared with `enriched`),
 //!    energy-norm residual
 //!    `eps_j = sqrt(d_j^H K_s d_j) / sqrt(u_j^H K_s u_j)`
 //!    ([`squeal_core::reduction::energy_residuals`], formed from the images `K_c V`,
@@ -37,10 +40,12 @@
 use squeal_core::faer::Mat;
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
-    coupled_real_modes_on, m_orthonormalize, GrowingBasis, StaticSolver, DEFAULT_RANK_TOL,
+    coupled_real_modes_on, m_orthonormalize, GrowingBasis, PairSolves, StaticSolver,
+    DEFAULT_RANK_TOL, PAIR_SOLVES_STAGE_KEY,
 };
 use squeal_core::{
-    Basis, BasisRequest, EigenParams, Error, Params, ReductionBasis, Registry, Result,
+    Basis, BasisRequest, EigenParams, Error, FreeModel, ModelStage, Params, ReductionBasis,
+    Registry, Result,
 };
 use std::time::Instant;
 
@@ -129,6 +134,16 @@ impl ReductionBasis for ResidueBasis {
         true
     }
 
+    /// The free model's pair solves when the static shift is 0: every `K_c` is then
+    /// solved through them.
+    fn stage_key(&self, _band_top_hz: f64) -> Option<String> {
+        (self.shift_hz == 0.0).then(|| PAIR_SOLVES_STAGE_KEY.into())
+    }
+
+    fn prepare(&self, free: &FreeModel<'_>) -> Result<Option<ModelStage>> {
+        PairSolves::stage(free)
+    }
+
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {
         let (op, mu) = (request.op, request.mu);
         let mc = op.mc.as_ref();
@@ -138,7 +153,7 @@ impl ReductionBasis for ResidueBasis {
         // and every static response
         let shift = (2.0 * std::f64::consts::PI * self.shift_hz).powi(2);
         let clock = Instant::now();
-        let ks = StaticSolver::new(op, shift)?;
+        let ks = StaticSolver::tied_or_new(op, PairSolves::in_stage(request.stage), shift)?;
         let t_factor = clock.elapsed().as_secs_f64();
         let modes = coupled_real_modes_on(request, cutoff, &ks)?;
         let t_modes = clock.elapsed().as_secs_f64() - t_factor;
@@ -213,14 +228,15 @@ impl ReductionBasis for ResidueBasis {
             format!(
                 "{NAME}: {start_size} real modes up to {cutoff:.1} Hz (`{}`) + {} residual \
                  vectors in {iterations} iterations at mu = {mu}; energy residuals {:?}; \
-                 times: K_s factorization {t_factor:.2} s (shared by modes and residuals), \
-                 modes {t_modes:.2} s, iterations {:.2} s",
+                 {}; times: set-up {t_factor:.2} s (shared by modes and residuals), modes \
+                 {t_modes:.2} s, iterations {:.2} s",
                 request.modal.name(),
                 basis.len() - start_size,
                 history
                     .iter()
                     .map(|r| format!("{r:.2e}"))
                     .collect::<Vec<_>>(),
+                ks.method,
                 clock.elapsed().as_secs_f64()
             ),
         );

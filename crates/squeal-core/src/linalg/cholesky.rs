@@ -128,11 +128,6 @@ impl Cholesky {
         self.llt.solve_in_place(b);
     }
 
-    /// The factor itself, for operators that apply it ([`crate::spectral::ShiftInvert`]).
-    pub(crate) fn llt(&self) -> &SparseLlt {
-        &self.llt
-    }
-
     /// `y <- A^-1 y`.
     pub fn solve_vec_in_place(&self, y: &mut [f64]) {
         let n = y.len();

@@ -7,6 +7,20 @@ mod complex;
 pub use cholesky::Cholesky;
 pub(crate) use cholesky::{LltFailure, SparseLlt};
 pub use complex::spmv_complex;
+
+/// A solver of `A X = B` in place for a block of right-hand sides: a sparse factorization
+/// ([`Cholesky`]), or a solve assembled from others (the tied solves of
+/// [`crate::reduction::TiedSolve`]).
+pub trait BlockSolve: Send + Sync {
+    /// `B <- A^-1 B`.
+    fn solve_block(&self, b: MatMut<'_, f64>);
+}
+
+impl BlockSolve for Cholesky {
+    fn solve_block(&self, b: MatMut<'_, f64>) {
+        self.solve_in_place(b);
+    }
+}
 pub(crate) use complex::{norm2_c, spmv_complex_add, spmv_complex_split};
 
 use crate::{Error, Result, SparseMat, SparseRef};

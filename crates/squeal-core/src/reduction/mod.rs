@@ -5,7 +5,9 @@
 //!   [`m_orthonormal_extend`]) and an optional SVD compression ([`m_svd_compress`]);
 //! - the coupled mu = 0 real modes ([`coupled_real_modes`]), the friction load directions
 //!   ([`friction_load_directions`]) and static responses with one reused factorization
-//!   ([`StaticSolver`]), which the real modes can share ([`coupled_real_modes_on`]);
+//!   ([`StaticSolver`]), which the real modes can share ([`coupled_real_modes_on`]), or
+//!   solves with any contact set's `K_c` through one factorization of the free model
+//!   ([`PairSolves`], a model stage);
 //! - projection of every part of a [`FrictionalOperator`](crate::operator::FrictionalOperator) on a basis ([`project`]), or of a
 //!   basis grown column by column with the images of its columns kept ([`GrowingBasis`]), the
 //!   reduced solve with any [`EigenSolver`](crate::EigenSolver), and the expansion of the reduced modes with
@@ -53,6 +55,7 @@ mod solve;
 mod statics;
 #[cfg(test)]
 mod tests;
+mod tied;
 
 pub use crate::linalg::expand;
 pub use candidates::{coupled_real_modes, coupled_real_modes_on, friction_load_directions};
@@ -65,6 +68,7 @@ pub use orthonormal::{
 pub use project::{dense_to_sparse, project};
 pub use solve::{solve_reduced, ReducedOperator, ReducedSolve};
 pub use statics::{energy_residuals, StaticSolver};
+pub use tied::{PairSolves, TiedSolve, PAIR_SOLVES_LIMIT_BYTES, PAIR_SOLVES_STAGE_KEY};
 
 fn par() -> Par {
     faer::get_global_parallelism()

@@ -2,26 +2,32 @@
 //! energy-norm residuals of reduced modes ([`energy_residuals`]).
 
 use super::sparse_times;
+use super::PairSolves;
 use crate::linalg::spmv_complex;
-use crate::linalg::{add_scaled, Cholesky};
+use crate::linalg::{add_scaled, BlockSolve, Cholesky};
 use crate::operator::FrictionalOperator;
 use crate::spectral::ShiftInvert;
 use crate::{c64, Error, Result, SparseMat, SparseRef};
 use faer::{Mat, MatRef};
+use std::borrow::Cow;
 use std::time::Instant;
 
-/// Static responses `K_s^-1 R` with `K_s = K_c + shift M_c` factorized once (sparse
-/// Cholesky; `shift` in (rad/s)^2, `>= 0`).
-pub struct StaticSolver {
-    factor: Cholesky,
-    ks: SparseMat,
+/// Static responses `K_s^-1 R` with `K_s = K_c + shift M_c` (`shift` in (rad/s)^2,
+/// `>= 0`): factorized once (sparse Cholesky, [`StaticSolver::new`]), or, at shift 0,
+/// solved through the free model's factor and the pairs of the contact set
+/// ([`StaticSolver::tied`]).
+pub struct StaticSolver<'a> {
+    factor: Box<dyn BlockSolve + 'a>,
+    ks: Cow<'a, SparseMat>,
     /// The shift (rad/s)^2.
     pub shift: f64,
-    /// Factorization time (s).
+    /// Set-up time (s): the factorization, or the Schur complement of the tied solve.
     pub time_s: f64,
+    /// How `K_s` is solved, for a basis's note.
+    pub method: String,
 }
 
-impl StaticSolver {
+impl<'a> StaticSolver<'a> {
     /// Factorizes `K_c + shift M_c`.
     pub fn new(op: &FrictionalOperator, shift: f64) -> Result<Self> {
         let start = Instant::now();
@@ -34,22 +40,54 @@ impl StaticSolver {
         let ks = add_scaled(op.kc.as_ref(), 1.0, op.mc.as_ref(), shift)?;
         let factor = Cholesky::new(ks.as_ref(), "K_c + shift M_c (static responses)")?;
         Ok(Self {
-            factor,
-            ks,
+            factor: Box::new(factor),
+            ks: Cow::Owned(ks),
             shift,
             time_s: start.elapsed().as_secs_f64(),
+            method: "K_c factorization".into(),
         })
+    }
+
+    /// Solves with `K_c` (shift 0) of the contact set of `op` through the free model's
+    /// `pairs` ([`PairSolves::on`]): no factorization of its own.
+    pub fn tied(op: &'a FrictionalOperator, pairs: &'a PairSolves) -> Result<Self> {
+        let start = Instant::now();
+        let solve = pairs.on(op)?;
+        let method = format!(
+            "K_c solved through the free model's factor ({} tied pairs)",
+            solve.active_pairs()
+        );
+        Ok(Self {
+            factor: Box::new(solve),
+            ks: Cow::Borrowed(&op.kc),
+            shift: 0.0,
+            time_s: start.elapsed().as_secs_f64(),
+            method,
+        })
+    }
+
+    /// [`tied`](Self::tied) when the basis has the free model's `pairs` (its model stage)
+    /// and `shift` is 0, else [`new`](Self::new).
+    pub fn tied_or_new(
+        op: &'a FrictionalOperator,
+        pairs: Option<&'a PairSolves>,
+        shift: f64,
+    ) -> Result<Self> {
+        match pairs {
+            Some(p) if shift == 0.0 && op.t.is_some() => Self::tied(op, p),
+            _ => Self::new(op, shift),
+        }
     }
 
     /// `R <- K_s^-1 R` for a block of right-hand sides.
     pub fn solve_in_place(&self, r: faer::MatMut<'_, f64>) {
-        self.factor.solve_in_place(r);
+        self.factor.solve_block(r);
     }
 
     /// The shift-invert operator `(K_c + shift M_c)^-1 M_c` (`sigma = -shift`) on this
     /// solver's factorization, for the real modes of `(K_c, M_c)` by
     /// [`super::coupled_real_modes_on`]: `m` must be the operator's `M_c`.
-    pub fn shift_invert<'a>(&'a self, m: SparseRef<'a>) -> Result<ShiftInvert<'a>> {
+    pub fn shift_invert<'s>(&'s self, m: SparseRef<'s>) -> Result<ShiftInvert<'s>> {
         if m.nrows() != self.ks.nrows() || m.ncols() != self.ks.ncols() {
             return Err(Error::Dimension {
                 context: "static solver: M_c of the shift-invert operator".into(),
@@ -60,14 +98,14 @@ impl StaticSolver {
         Ok(ShiftInvert::with_factor(
             m,
             -self.shift,
-            self.ks.as_ref(),
-            &self.factor,
+            self.ks.as_ref().as_ref(),
+            self.factor.as_ref(),
         ))
     }
 
-    /// The factorized matrix `K_s`.
+    /// The matrix `K_s` this solver solves with.
     pub fn matrix(&self) -> SparseRef<'_> {
-        self.ks.as_ref()
+        self.ks.as_ref().as_ref()
     }
 }
 

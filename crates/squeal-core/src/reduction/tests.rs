@@ -1,6 +1,6 @@
 use super::project::dense_to_sparse;
 use super::*;
-use crate::contact::{Basis, BasisRequest};
+use crate::contact::{Basis, BasisRequest, FreeModel, PairDofs};
 use crate::eigen::{
     dense_symmetric, finish_real_modes, EigenParams, EigenSolver, SymmetricProblem,
 };
@@ -484,4 +484,136 @@ fn a_grown_basis_projects_and_measures_residuals_as_the_direct_path() {
         dd <= 1e-10 * scale,
         "static responses differ by {dd:e} of {scale:e}"
     );
+}
+
+/// A free model of two bodies (DOFs `0..15` and `15..30`, each a random banded symmetric
+/// positive definite stiffness, not coupled) with four candidate pairs (pin node `i` at
+/// DOFs `3i..3i+3`, disc node at `15 + 3i..`), and the operator that ties the pairs
+/// `active`: the pin's normal DOF eliminated into its disc partner, the rest renumbered.
+fn tied_model(active: &[usize]) -> (SparseMat, Vec<PairDofs>, FrictionalOperator, Mat<f64>) {
+    const N: usize = 30;
+    let mut rng = Rng(29);
+    let mut k = Mat::<f64>::zeros(N, N);
+    for body in [0..15, 15..30] {
+        for i in body.clone() {
+            k[(i, i)] += 4.0 + rng.next();
+            for j in (i + 1)..(i + 4).min(body.end) {
+                let s = 1.0 + 0.5 * rng.next();
+                k[(i, i)] += s;
+                k[(j, j)] += s;
+                k[(i, j)] -= s;
+                k[(j, i)] -= s;
+            }
+        }
+    }
+    let k = &k * faer::Scale(1e7);
+    let pairs: Vec<PairDofs> = (0..4)
+        .map(|i| PairDofs {
+            pin: [3 * i, 3 * i + 1, 3 * i + 2],
+            disc: [15 + 3 * i, 15 + 3 * i + 1, 15 + 3 * i + 2],
+            direction: [1.0, 0.0, 0.0],
+        })
+        .collect();
+    let eliminated: Vec<usize> = active.iter().map(|&i| pairs[i].pin[2]).collect();
+    let kept: Vec<usize> = (0..N).filter(|j| !eliminated.contains(j)).collect();
+    let t: Vec<usize> = (0..N)
+        .map(|j| {
+            let to = active
+                .iter()
+                .find(|&&i| pairs[i].pin[2] == j)
+                .map_or(j, |&i| pairs[i].disc[2]);
+            kept.iter().position(|&x| x == to).unwrap()
+        })
+        .collect();
+    let nc = kept.len();
+    let mut kc = Mat::<f64>::zeros(nc, nc);
+    for j in 0..N {
+        for i in 0..N {
+            kc[(t[i], t[j])] += k[(i, j)];
+        }
+    }
+    let id = sparse(Mat::<f64>::identity(nc, nc).as_ref());
+    let op = FrictionalOperator {
+        mc: id.clone(),
+        cc: None,
+        kc: sparse(kc.as_ref()),
+        fm: sparse(Mat::<f64>::zeros(nc, nc).as_ref()),
+        fc: None,
+        fk: sparse(Mat::<f64>::zeros(nc, nc).as_ref()),
+        t: Some(t),
+        friction_loads: None,
+    };
+    (sparse(k.as_ref()), pairs, op, kc)
+}
+
+fn pair_solves(k: &SparseMat, pairs: &[PairDofs]) -> Result<PairSolves> {
+    let m = sparse(Mat::<f64>::identity(k.nrows(), k.nrows()).as_ref());
+    let modes = |_: f64| -> Result<RealModes> { unreachable!("tied solves need no modes") };
+    PairSolves::new(&FreeModel {
+        k: k.as_ref(),
+        m: m.as_ref(),
+        pairs,
+        k_factor: None,
+        normal_modes: &modes,
+        modal: &Dense,
+        band_hz: (0.0, 1.0),
+        params: &wide_band(),
+    })
+}
+
+#[test]
+fn tied_solves_through_the_free_factor_match_the_factorized_tied_stiffness() {
+    for active in [vec![0, 2, 3], vec![1], vec![], vec![0, 1, 2, 3]] {
+        let (k, pairs, op, kc) = tied_model(&active);
+        let solves = pair_solves(&k, &pairs).unwrap();
+        let tied = StaticSolver::tied(&op, &solves).unwrap();
+        let direct = StaticSolver::new(&op, 0.0).unwrap();
+        let b = Rng(7).mat(op.dim(), 5);
+        let (mut x, mut y) = (b.clone(), b.clone());
+        tied.solve_in_place(x.as_mut());
+        direct.solve_in_place(y.as_mut());
+        let scale = (0..5)
+            .flat_map(|c| (0..op.dim()).map(move |r| (r, c)))
+            .fold(0.0f64, |a, (r, c)| a.max(y[(r, c)].abs()));
+        for c in 0..5 {
+            for r in 0..op.dim() {
+                assert!(
+                    (x[(r, c)] - y[(r, c)]).abs() <= 1e-12 * scale,
+                    "active {active:?}: {} vs {}",
+                    x[(r, c)],
+                    y[(r, c)]
+                );
+            }
+        }
+        // and it is K_c's solve: K_c x = b
+        let kx = &kc * &x;
+        let worst = (0..5)
+            .flat_map(|c| (0..op.dim()).map(move |r| (r, c)))
+            .fold(0.0f64, |a, (r, c)| a.max((kx[(r, c)] - b[(r, c)]).abs()));
+        assert!(worst <= 1e-9, "active {active:?}: residual {worst:e}");
+        assert!(tied
+            .method
+            .contains(&format!("{} tied pairs", active.len())));
+    }
+}
+
+#[test]
+fn tied_solves_refuse_an_operator_they_do_not_describe() {
+    let (k, pairs, mut op, _) = tied_model(&[0, 2]);
+    let solves = pair_solves(&k, &pairs).unwrap();
+    // a map that merges two DOFs that are not the normals of a pair
+    let mut t = op.t.clone().unwrap();
+    t[pairs[1].pin[0]] = t[pairs[1].disc[0]];
+    op.t = Some(t);
+    let e = StaticSolver::tied(&op, &solves).err().unwrap().to_string();
+    assert!(e.contains("not the normals"), "{e}");
+    op.t = None;
+    let e = StaticSolver::tied(&op, &solves).err().unwrap().to_string();
+    assert!(e.contains("no index map"), "{e}");
+    // without pair solves (or at a shift) the solver factorizes its own K_c
+    op.t = tied_model(&[0, 2]).2.t;
+    let own = StaticSolver::tied_or_new(&op, None, 0.0).unwrap();
+    assert_eq!(own.method, "K_c factorization");
+    let shifted = StaticSolver::tied_or_new(&op, Some(&solves), 1.0).unwrap();
+    assert_eq!(shifted.method, "K_c factorization");
 }

@@ -5,27 +5,27 @@
 //! factorization serves every application.
 
 use super::{LinOp, SpectralTransform};
-use crate::linalg::{add_scaled, check_square_finite, spmv, Cholesky, LltFailure, SparseLlt};
+use crate::linalg::{add_scaled, check_square_finite, spmv, BlockSolve, LltFailure, SparseLlt};
 use crate::{Error, Result, SparseRef};
 use faer::MatMut;
 
-/// `K - sigma M` and its factor: the operator's own, or ones its caller holds.
+/// `K - sigma M` and its solver: the operator's own factor, or a solver its caller holds.
 enum Factor<'a> {
     Owned {
         llt: Box<SparseLlt>,
         shifted: crate::SparseMat,
     },
     Borrowed {
-        llt: &'a SparseLlt,
+        solve: &'a dyn BlockSolve,
         shifted: SparseRef<'a>,
     },
 }
 
 impl Factor<'_> {
-    fn llt(&self) -> &SparseLlt {
+    fn solve_in_place(&self, b: MatMut<'_, f64>) {
         match self {
-            Factor::Owned { llt, .. } => llt,
-            Factor::Borrowed { llt, .. } => llt,
+            Factor::Owned { llt, .. } => llt.solve_in_place(b),
+            Factor::Borrowed { solve, .. } => solve.solve_block(b),
         }
     }
 
@@ -75,23 +75,20 @@ impl<'a> ShiftInvert<'a> {
         })
     }
 
-    /// The operator on a factorization the caller already holds: `shifted` must be
-    /// `K - sigma M` for this `m` and `sigma` and `factor` its Cholesky factor (as the
-    /// static solver of [`crate::reduction::StaticSolver::shift_invert`] guarantees), so
-    /// real modes and static responses share one factorization.
+    /// The operator on a solver the caller already holds: `shifted` must be
+    /// `K - sigma M` for this `m` and `sigma` and `solve` a solver of it (as the static
+    /// solver of [`crate::reduction::StaticSolver::shift_invert`] guarantees), so real
+    /// modes and static responses share one factorization.
     pub(crate) fn with_factor(
         m: SparseRef<'a>,
         sigma: f64,
         shifted: SparseRef<'a>,
-        factor: &'a Cholesky,
+        solve: &'a dyn BlockSolve,
     ) -> Self {
         Self {
             m,
             sigma,
-            factor: Factor::Borrowed {
-                llt: factor.llt(),
-                shifted,
-            },
+            factor: Factor::Borrowed { solve, shifted },
             applications: std::sync::atomic::AtomicUsize::new(0),
         }
     }
@@ -115,7 +112,7 @@ impl<'a> ShiftInvert<'a> {
     pub fn solve_in_place(&self, y: &mut [f64]) {
         let n = y.len();
         let mat = MatMut::from_column_major_slice_mut(y, n, 1);
-        self.factor.llt().solve_in_place(mat);
+        self.factor.solve_in_place(mat);
     }
 
     /// `Y <- (K - sigma M)^-1 Y` for a block of columns, each counted as one application
@@ -123,7 +120,7 @@ impl<'a> ShiftInvert<'a> {
     /// what makes block Krylov methods cheaper per column on large factors.
     pub fn solve_block_in_place(&self, mut y: MatMut<'_, f64>) {
         let cols = y.ncols();
-        self.factor.llt().solve_in_place(y.as_mut());
+        self.factor.solve_in_place(y.as_mut());
         self.applications
             .fetch_add(cols, std::sync::atomic::Ordering::Relaxed);
     }
