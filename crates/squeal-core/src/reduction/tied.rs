@@ -72,7 +72,7 @@ impl PairSolves {
     }
 
     /// The pair solves in a basis request's model stage, if that is what it holds.
-    pub fn in_stage<'a>(stage: Option<&'a (dyn std::any::Any + Send + Sync)>) -> Option<&'a Self> {
+    pub fn in_stage(stage: Option<&(dyn std::any::Any + Send + Sync)>) -> Option<&Self> {
         stage.and_then(|s| s.downcast_ref::<Self>())
     }
 
