@@ -177,8 +177,8 @@ impl PairSolves {
         let active: Vec<usize> = (0..self.pairs())
             .filter(|&i| t[self.normals[i].0] == t[self.normals[i].1])
             .collect();
-        let tied = n - nc;
-        if tied != active.len() || count.iter().any(|&k| k == 0 || k > 2) {
+        let tied = n.saturating_sub(nc);
+        if nc > n || tied != active.len() || count.iter().any(|&k| k == 0 || k > 2) {
             return Err(Error::Invalid(format!(
                 "tied solves: the operator ties {tied} DOFs, not the normals of {} candidate \
                  pairs alone",
