@@ -105,9 +105,10 @@ impl ReductionBasis for EnrichedBasis {
         let op = request.op;
         let mc = op.mc.as_ref();
         let cutoff = self.cutoff_factor * request.band_hz.1;
-        // one factorization of K_c serves the real modes (shift-invert at sigma = 0: the
-        // static responses need K_c itself, and it is positive definite when they exist)
-        // and the static responses
+        // one solver of K_c (through the model stage's pair solves, or a factorization of
+        // its own) serves the real modes (shift-invert at sigma = 0: the static responses
+        // need K_c itself, and it is positive definite when they exist) and the static
+        // responses
         let clock = Instant::now();
         let mut ks = StaticSolver::tied_or_new(op, PairSolves::in_stage(request.stage), 0.0)?;
         let t_factor = clock.elapsed().as_secs_f64();
@@ -120,7 +121,8 @@ impl ReductionBasis for EnrichedBasis {
         let clock = Instant::now();
         ks.solve_in_place(statics.as_mut());
         let t_statics = clock.elapsed().as_secs_f64();
-        // the factor is the largest allocation here: freed before the orthonormalization
+        // a factor of its own is the largest allocation here: freed before the
+        // orthonormalization
         let method = std::mem::take(&mut ks.method);
         drop(ks);
         let finite = (0..statics.ncols())
