@@ -51,6 +51,14 @@ pub struct PairSolves {
     pub time_s: f64,
 }
 
+/// Bytes of the responses `Z` of the free model's candidate pairs.
+fn response_bytes(free: &FreeModel<'_>) -> usize {
+    free.k
+        .nrows()
+        .saturating_mul(free.pairs.len())
+        .saturating_mul(8)
+}
+
 /// The model-stage key ([`crate::ReductionBasis::stage_key`]) of [`PairSolves`]: bases
 /// that solve with `K_c` return it and share one stage.
 pub const PAIR_SOLVES_STAGE_KEY: &str = "tied solves: the free model's factor and pair responses";
@@ -60,12 +68,7 @@ impl PairSolves {
     /// the pair solves of `free`, or `None` (the basis then factorizes each `K_c`) when
     /// their responses would pass [`PAIR_SOLVES_LIMIT_BYTES`].
     pub fn stage(free: &FreeModel<'_>) -> Result<Option<ModelStage>> {
-        let bytes = free
-            .k
-            .nrows()
-            .saturating_mul(free.pairs.len())
-            .saturating_mul(8);
-        if bytes > PAIR_SOLVES_LIMIT_BYTES || free.pairs.is_empty() {
+        if response_bytes(free) > PAIR_SOLVES_LIMIT_BYTES || free.pairs.is_empty() {
             return Ok(None);
         }
         Ok(Some(Arc::new(Self::new(free)?)))
@@ -82,7 +85,7 @@ impl PairSolves {
         let start = Instant::now();
         let n = free.k.nrows();
         let np = free.pairs.len();
-        let bytes = n.saturating_mul(np).saturating_mul(8);
+        let bytes = response_bytes(free);
         if bytes > PAIR_SOLVES_LIMIT_BYTES {
             return Err(Error::Invalid(format!(
                 "tied solves on the free model need {:.2} GiB for the responses of {np} \
