@@ -188,16 +188,14 @@ pub const KRYLOV: KrylovSolver = KernelSolver::new(
 );
 
 /// Most pairs one call of the block kernel is asked for; larger calls take the
-/// single-vector kernel. Measured: up to 47 pairs (the disc's modes, the tied rig's real
-/// modes) the block kernel converges to `tol = 1e-10` in a few restarts. On the coarse
-/// rig's free model, 96 pairs whose smallest wanted theta lie in clusters of relative
-/// width 1e-3 at the end of the wanted range, it does not: its residual estimates fall by
-/// about 10 % per restart, and it runs into the restart cap (12 s against the
-/// single-vector kernel's 0.1 s). A basis of `cap` columns in blocks of `b` holds a
-/// polynomial of degree `cap / b` in `OP`, and each thick restart adds only
-/// `(cap - k) / b` (13 there) against the single-vector kernel's `ncv - k` (96): the
-/// filter that separates a cluster from its neighbours is `b` times weaker.
-pub const BLOCK_MAX_NEV: usize = 48;
+/// single-vector kernel. Measured with blocks of 8 and a basis of four times the wanted
+/// pairs: the tied rig's real modes (24 pairs) and the default rig's free model (69 pairs,
+/// 26.8 s against 56 s in the single-vector kernel) converge to `tol = 1e-10` in one
+/// restart at most, and so do the coarse rig's free model's 96 pairs, whose smallest
+/// wanted theta lie in clusters of relative width 1e-3 at the end of the wanted range.
+/// Above this the basis (`2 n` values per column, about 1.1 GB at 96 pairs on the
+/// default rig) outgrows the single-vector kernel's.
+pub const BLOCK_MAX_NEV: usize = 96;
 
 /// Default of the `block` parameter: columns per application of `OP` in the normal-mode
 /// Lanczos.
