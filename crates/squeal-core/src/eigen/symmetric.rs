@@ -3,7 +3,7 @@
 //! the dense solver ([`dense_symmetric`]).
 
 use super::{too_many_modes, validate_params, EigenParams};
-use crate::linalg::{col, dot, norm1, norm2, sparse_transpose_times};
+use crate::linalg::{col, dot, norm1, norm2, symmetric_times};
 use crate::operator::{RealModes, SolveInfo, StopReason};
 use crate::spectral::{LinOp, ShiftInvert, SpectralTransform};
 use crate::{Error, Result, SparseRef};
@@ -205,7 +205,7 @@ pub fn finish_real_modes(
     // M-normalization and residuals by two block products (K and M are symmetric, so
     // the gather products apply): one pass over each matrix for all the modes
     let mut out_vec = Mat::from_fn(n, keep.len(), |r, c| vectors[(r, keep[c].1)]);
-    let mut mx = sparse_transpose_times(problem.m, out_vec.as_ref());
+    let mut mx = symmetric_times(problem.m, out_vec.as_ref());
     for c in 0..keep.len() {
         let scale = dot(col(&out_vec, c), col(&mx, c)).sqrt();
         if scale > 0.0 {
@@ -213,7 +213,7 @@ pub fn finish_real_modes(
             mx.col_mut(c).iter_mut().for_each(|v| *v /= scale);
         }
     }
-    let kx = sparse_transpose_times(problem.k, out_vec.as_ref());
+    let kx = symmetric_times(problem.k, out_vec.as_ref());
     let residuals: Vec<f64> = keep
         .iter()
         .enumerate()

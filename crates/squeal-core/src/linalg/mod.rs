@@ -99,6 +99,16 @@ pub fn sparse_times(a: SparseRef<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
     product(a, x, Product::Scatter)
 }
 
+/// `A X` for a symmetric sparse `A` (both triangles stored): the gather product
+/// [`sparse_transpose_times`], `A^T X = A X`, about twice as fast as [`sparse_times`]
+/// (no scattered writes). For the mass and stiffness matrices and their images.
+///
+/// # Panics
+/// If `A` has not as many rows as `X` (a programming error, as in faer).
+pub fn symmetric_times(a: SparseRef<'_>, x: MatRef<'_, f64>) -> Mat<f64> {
+    sparse_transpose_times(a, x)
+}
+
 /// `A^T X` for a sparse `A` (CSC) and a dense `X`: every entry is a gather over one
 /// column of `A` (its rows in ascending order), so no entry of the result is written more
 /// than once. With the columns of `X` in blocks of 16, 8 or 4 run in parallel as in
@@ -515,6 +525,57 @@ mod tests {
             }
             assert!((0..c).all(|k| got[(11, k)] == 0.0), "an empty column of A");
         }
+    }
+
+    #[test]
+    fn symmetric_times_is_the_product_for_symmetric_matrices_and_only_those() {
+        // a symmetric 23 x 23 pattern (both triangles stored), an empty row/column, values
+        // of mixed sign; the same pattern with one off-diagonal entry changed is not
+        // symmetric, and there the gather product gives A^T X, not A X
+        let mut state = 5u64;
+        let mut rnd = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let n = 23;
+        let mut t = Vec::new();
+        for j in 0..n {
+            for i in j..n {
+                if (i * 3 + j * 5) % 4 == 0 && i != 6 && j != 6 {
+                    let v = rnd();
+                    t.push(Triplet::new(i, j, v));
+                    if i != j {
+                        t.push(Triplet::new(j, i, v));
+                    }
+                }
+            }
+        }
+        let a = SparseMat::try_new_from_triplets(n, n, &t).unwrap();
+        let x = Mat::from_fn(n, 13, |_, _| rnd());
+        let got = symmetric_times(a.as_ref(), x.as_ref());
+        let want = sparse_times(a.as_ref(), x.as_ref());
+        let scale = want.norm_max();
+        assert!(scale > 0.0);
+        assert!((&got - &want).norm_max() <= 1e-15 * scale * n as f64);
+        assert!(
+            (0..13).all(|k| got[(6, k)] == 0.0),
+            "the empty row and column"
+        );
+        // one entry of the upper triangle changed: no longer symmetric
+        let (i, j) = t
+            .iter()
+            .map(|e| (e.row, e.col))
+            .find(|&(i, j)| i < j)
+            .unwrap();
+        t.push(Triplet::new(i, j, 1.0));
+        let b = SparseMat::try_new_from_triplets(n, n, &t).unwrap();
+        let diff = &symmetric_times(b.as_ref(), x.as_ref()) - &sparse_times(b.as_ref(), x.as_ref());
+        assert!(
+            diff.norm_max() > 0.1 * scale,
+            "a non-symmetric matrix is told apart"
+        );
     }
 
     #[test]

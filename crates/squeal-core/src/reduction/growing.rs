@@ -8,7 +8,7 @@ use super::orthonormal::m_orthonormal_extend_in_place;
 use super::project::{dense_to_sparse, project_loads, project_part};
 use super::statics::{energy_norms, StaticSolver};
 use super::{expand, sparse_times, tmul};
-use crate::linalg::spmv_complex;
+use crate::linalg::{spmv_complex, symmetric_times};
 use crate::operator::FrictionalOperator;
 use crate::{c64, Error, Result, SparseMat};
 use faer::{Mat, MatRef};
@@ -47,8 +47,8 @@ impl<'a> GrowingBasis<'a> {
                 got: v.nrows(),
             });
         }
-        let mv = sparse_times(op.mc.as_ref(), v.as_ref());
-        let kv = sparse_times(op.kc.as_ref(), v.as_ref());
+        let mv = symmetric_times(op.mc.as_ref(), v.as_ref());
+        let kv = symmetric_times(op.kc.as_ref(), v.as_ref());
         let cv = op.cc.as_ref().map(|c| sparse_times(c.as_ref(), v.as_ref()));
         Ok(Self { op, v, mv, kv, cv })
     }
@@ -86,12 +86,15 @@ impl<'a> GrowingBasis<'a> {
         if w.ncols() > 0 {
             // the images of the new columns by exact sparse products (the orthonormalization
             // carried `M w` through its projections, with their roundoff)
-            let mw = sparse_times(mc, w);
+            let mw = symmetric_times(mc, w);
             self.mv
                 .as_mut()
                 .subcols_mut(before, w.ncols())
                 .copy_from(&mw);
-            append(&mut self.kv, sparse_times(self.op.kc.as_ref(), w).as_ref());
+            append(
+                &mut self.kv,
+                symmetric_times(self.op.kc.as_ref(), w).as_ref(),
+            );
             if let (Some(cv), Some(c)) = (&mut self.cv, &self.op.cc) {
                 append(cv, sparse_times(c.as_ref(), w).as_ref());
             }

@@ -2,8 +2,8 @@
 //! [`m_orthonormal_extend`], described in the module docs of [`crate::reduction`]) and
 //! SVD compression ([`m_svd_compress`]).
 
-use super::{par, sparse_times, tmul};
-use crate::linalg::{col, dot, spmv};
+use super::{par, tmul};
+use crate::linalg::{col, dot, spmv, symmetric_times};
 use crate::{Error, Result, SparseRef};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef};
@@ -62,7 +62,7 @@ pub fn m_orthonormal_extend(
 ) -> Result<(Mat<f64>, usize)> {
     check_rank_tol(rank_tol)?;
     check_dims(m, q, new)?;
-    m_orthonormal_extend_imaged(m, q, sparse_times(m, q).as_ref(), new, rank_tol)
+    m_orthonormal_extend_imaged(m, q, symmetric_times(m, q).as_ref(), new, rank_tol)
 }
 
 fn check_dims(m: SparseRef<'_>, q: MatRef<'_, f64>, new: MatRef<'_, f64>) -> Result<()> {
@@ -148,7 +148,7 @@ pub(crate) fn m_orthonormal_extend_in_place(
     while c0 < new.ncols() {
         let b = BLOCK.min(new.ncols() - c0);
         let mut blk = new.subcols(c0, b).to_owned();
-        let mut mblk = sparse_times(m, blk.as_ref());
+        let mut mblk = symmetric_times(m, blk.as_ref());
         let mut alive = vec![true; b];
         for c in 0..b {
             let nrm = dot(col(&blk, c), col(&mblk, c));
@@ -323,7 +323,7 @@ pub fn m_svd_compress(
     }
     let n = m.nrows();
     let mut s = v.to_owned();
-    let ms = sparse_times(m, v);
+    let ms = symmetric_times(m, v);
     for c in 0..s.ncols() {
         let nrm = (0..n).map(|r| s[(r, c)] * ms[(r, c)]).sum::<f64>().sqrt();
         let f = if nrm.is_finite() && nrm > 0.0 {
@@ -337,7 +337,7 @@ pub fn m_svd_compress(
     if q.ncols() == 0 {
         return Ok((q, v.ncols()));
     }
-    let r = tmul(sparse_times(m, q.as_ref()).as_ref(), s.as_ref());
+    let r = tmul(symmetric_times(m, q.as_ref()).as_ref(), s.as_ref());
     let svd = r
         .thin_svd()
         .map_err(|e| Error::Invalid(format!("SVD of the M-QR factor failed: {e:?}")))?;
@@ -355,7 +355,7 @@ pub fn m_svd_compress(
 
 /// Largest entry of `|V^T M V - I|`: how far `V` is from `M`-orthonormal.
 pub fn m_orthonormality_error(m: SparseRef<'_>, v: MatRef<'_, f64>) -> f64 {
-    let g = tmul(v, sparse_times(m, v).as_ref());
+    let g = tmul(v, symmetric_times(m, v).as_ref());
     let mut worst = 0.0f64;
     for j in 0..g.ncols() {
         for i in 0..g.nrows() {

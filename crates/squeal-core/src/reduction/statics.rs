@@ -1,10 +1,9 @@
 //! Static responses with one reused factorization ([`StaticSolver`]) and the
 //! energy-norm residuals of reduced modes ([`energy_residuals`]).
 
-use super::sparse_times;
 use super::PairSolves;
-use crate::linalg::spmv_complex;
 use crate::linalg::{add_scaled, BlockSolve, Cholesky};
+use crate::linalg::{spmv_complex, symmetric_times};
 use crate::operator::FrictionalOperator;
 use crate::spectral::ShiftInvert;
 use crate::{c64, Error, Result, SparseMat, SparseRef};
@@ -148,7 +147,7 @@ pub fn energy_residuals(
             z.im
         }
     });
-    let ksu = sparse_times(ks.matrix(), ur.as_ref());
+    let ksu = symmetric_times(ks.matrix(), ur.as_ref());
     energy_norms(ks, rr, ur.as_ref(), ksu.as_ref())
 }
 

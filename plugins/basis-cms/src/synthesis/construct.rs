@@ -178,7 +178,7 @@ impl FreeInterface {
         if let Some(st) = stored.as_mut().filter(|_| store_second) {
             // second-order residual terms K^-1 M K^-1 (Pn^T | Pt^T)
             for (z, y) in [(&st.zn, &mut st.yn), (&st.zt, &mut st.yt)] {
-                *y = squeal_core::linalg::sparse_times(m, z.as_ref());
+                *y = squeal_core::linalg::symmetric_times(m, z.as_ref());
                 solve_blocks(&factor, y);
             }
         }

@@ -97,7 +97,7 @@ impl FreeInterface {
                 };
                 if second {
                     let mut u =
-                        squeal_core::linalg::sparse_times(self.m.as_ref().as_ref(), z.as_ref());
+                        squeal_core::linalg::symmetric_times(self.m.as_ref().as_ref(), z.as_ref());
                     self.factor.solve_in_place(u.as_mut());
                     u
                 } else {
