@@ -489,15 +489,19 @@ mod tests {
         );
     }
 
-    #[test]
-    fn transpose_product_is_the_product_by_the_transpose() {
-        let mut state = 7u64;
-        let mut rnd = move || {
+    /// Deterministic values uniform in `[-0.5, 0.5)` (xorshift from `seed`).
+    fn xorshift(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        }
+    }
+
+    #[test]
+    fn transpose_product_is_the_product_by_the_transpose() {
+        let mut rnd = xorshift(7);
         // a non-symmetric 37 x 29 pattern with empty rows and columns
         let mut t = Vec::new();
         for j in 0..29 {
@@ -532,13 +536,7 @@ mod tests {
         // a symmetric 23 x 23 pattern (both triangles stored), an empty row/column, values
         // of mixed sign; the same pattern with one off-diagonal entry changed is not
         // symmetric, and there the gather product gives A^T X, not A X
-        let mut state = 5u64;
-        let mut rnd = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rnd = xorshift(5);
         let n = 23;
         let mut t = Vec::new();
         for j in 0..n {
