@@ -490,7 +490,8 @@ mod tests {
     }
 
     /// Deterministic values uniform in `[-0.5, 0.5)` (xorshift from `seed`).
-    fn xorshift(mut state: u64) -> impl FnMut() -> f64 {
+    fn xorshift(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
         move || {
             state ^= state << 13;
             state ^= state >> 7;
