@@ -11,7 +11,11 @@
 //! through the free model's factor and the Schur complement on the contact set's pairs
 //! (the model stage [`PairSolves`], built once per model, shared with `residue`), or
 //! through a sparse Cholesky factorization of `K_c` when there is no stage (an operator
-//! read from files). The basis's note says which and gives the time of each step.
+//! read from files). Through the stage the static responses need no solve of their own:
+//! the free model's response to each pair's friction load is solved the first time a
+//! contact set ties the pair and kept, and each contact set corrects the kept ones onto
+//! its ties ([`squeal_core::reduction::TiedSolve::friction_statics`]). The basis's note
+//! says which and gives the time of each step.
 //!
 //! Fixed in mu, not in contact set: built once per contact set (a new active set means
 //! a new `T` and a new basis) and reused across a whole mu sweep
@@ -28,8 +32,8 @@
 use squeal_core::linalg::norm2;
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
-    coupled_real_modes_on, friction_load_directions, m_orthonormal_extend, m_orthonormalize,
-    m_svd_compress, PairSolves, StaticSolver, DEFAULT_RANK_TOL, PAIR_SOLVES_STAGE_KEY,
+    coupled_real_modes_on, m_orthonormal_extend, m_orthonormalize, m_svd_compress, PairSolves,
+    StaticSolver, DEFAULT_RANK_TOL, PAIR_SOLVES_STAGE_KEY,
 };
 use squeal_core::{
     Basis, BasisRequest, Error, FreeModel, ModelStage, Params, ReductionBasis, Registry, Result,
@@ -116,10 +120,9 @@ impl ReductionBasis for EnrichedBasis {
         let t_modes = clock.elapsed().as_secs_f64() - t_factor;
         let (vm, dropped_modes) = m_orthonormalize(mc, modes.vectors.as_ref(), self.rank_tol)?;
         // static responses K_c^-1 U, one per active pair
-        let mut statics = friction_load_directions(op)?;
-        let loads = statics.ncols();
         let clock = Instant::now();
-        ks.solve_in_place(statics.as_mut());
+        let (statics, kept_responses) = ks.friction_statics(op)?;
+        let loads = statics.ncols();
         let t_statics = clock.elapsed().as_secs_f64();
         // a factor of its own is the largest allocation here: freed before the
         // orthonormalization
@@ -146,14 +149,20 @@ impl ReductionBasis for EnrichedBasis {
             "{NAME}: {} real modes up to {cutoff:.1} Hz (`{}`) + {} static vectors of {loads} \
              friction loads ({} removed by the SVD cut{}, {} by the rank cut); {}; times: set-up \
              {t_factor:.2} s (shared by modes and statics), modes {t_modes:.2} s, static \
-             solves {t_statics:.2} s, orthonormalization {t_orth:.2} s",
+             responses {t_statics:.2} s{}, orthonormalization {t_orth:.2} s",
             vm.ncols(),
             request.modal.name(),
             basis.len() - vm.ncols(),
             dropped_svd,
             self.svd_tol.map_or(String::new(), |t| format!(" at {t:e}")),
             dropped_static,
-            method
+            method,
+            if kept_responses {
+                " (corrected onto the ties from the free model's kept responses to the \
+                 pairs' friction loads)"
+            } else {
+                ""
+            }
         ));
         Ok(basis)
     }

@@ -1,7 +1,7 @@
 //! Static responses with one reused factorization ([`StaticSolver`]) and the
 //! energy-norm residuals of reduced modes ([`energy_residuals`]).
 
-use super::PairSolves;
+use super::{friction_load_directions, PairSolves, TiedSolve};
 use crate::linalg::{add_scaled, BlockSolve, Cholesky};
 use crate::linalg::{spmv_complex, symmetric_times};
 use crate::operator::FrictionalOperator;
@@ -11,12 +11,29 @@ use faer::{Mat, MatRef};
 use std::borrow::Cow;
 use std::time::Instant;
 
+/// How a [`StaticSolver`] solves.
+enum Backend<'a> {
+    /// A factorization of `K_s`.
+    Factor(Cholesky),
+    /// The free model's factor and the ties of the contact set.
+    Tied(TiedSolve<'a>),
+}
+
+impl BlockSolve for Backend<'_> {
+    fn solve_block(&self, b: faer::MatMut<'_, f64>) {
+        match self {
+            Self::Factor(f) => f.solve_block(b),
+            Self::Tied(t) => t.solve_block(b),
+        }
+    }
+}
+
 /// Static responses `K_s^-1 R` with `K_s = K_c + shift M_c` (`shift` in (rad/s)^2,
 /// `>= 0`): factorized once (sparse Cholesky, [`StaticSolver::new`]), or, at shift 0,
 /// solved through the free model's factor and the pairs of the contact set
 /// ([`StaticSolver::tied`]).
 pub struct StaticSolver<'a> {
-    factor: Box<dyn BlockSolve + 'a>,
+    factor: Backend<'a>,
     ks: Cow<'a, SparseMat>,
     /// The shift (rad/s)^2.
     pub shift: f64,
@@ -39,7 +56,7 @@ impl<'a> StaticSolver<'a> {
         let ks = add_scaled(op.kc.as_ref(), 1.0, op.mc.as_ref(), shift)?;
         let factor = Cholesky::new(ks.as_ref(), "K_c + shift M_c (static responses)")?;
         Ok(Self {
-            factor: Box::new(factor),
+            factor: Backend::Factor(factor),
             ks: Cow::Owned(ks),
             shift,
             time_s: start.elapsed().as_secs_f64(),
@@ -57,7 +74,7 @@ impl<'a> StaticSolver<'a> {
             solve.active_pairs()
         );
         Ok(Self {
-            factor: Box::new(solve),
+            factor: Backend::Tied(solve),
             ks: Cow::Borrowed(&op.kc),
             shift: 0.0,
             time_s: start.elapsed().as_secs_f64(),
@@ -83,6 +100,21 @@ impl<'a> StaticSolver<'a> {
         self.factor.solve_block(r);
     }
 
+    /// The static responses to the friction loads `K_s^-1 U` (`U`: the operator's friction
+    /// load directions, [`friction_load_directions`]) and whether they came from the free
+    /// model's kept responses to the pairs' friction loads
+    /// ([`TiedSolve::friction_statics`]: no solve of the whole block) rather than a solve.
+    pub fn friction_statics(&self, op: &FrictionalOperator) -> Result<(Mat<f64>, bool)> {
+        if let (Backend::Tied(tied), Some(u)) = (&self.factor, &op.friction_loads) {
+            if let Some(x) = tied.friction_statics(u.as_ref()) {
+                return Ok((x, true));
+            }
+        }
+        let mut u = friction_load_directions(op)?;
+        self.solve_in_place(u.as_mut());
+        Ok((u, false))
+    }
+
     /// The shift-invert operator `(K_c + shift M_c)^-1 M_c` (`sigma = -shift`) on this
     /// solver's factorization, for the real modes of `(K_c, M_c)` by
     /// [`super::coupled_real_modes_on`]: `m` must be the operator's `M_c`.
@@ -98,7 +130,7 @@ impl<'a> StaticSolver<'a> {
             m,
             -self.shift,
             self.ks.as_ref().as_ref(),
-            self.factor.as_ref(),
+            &self.factor,
         ))
     }
 

@@ -511,7 +511,7 @@ fn tied_model(active: &[usize]) -> (SparseMat, Vec<PairDofs>, FrictionalOperator
         .map(|i| PairDofs {
             pin: [3 * i, 3 * i + 1, 3 * i + 2],
             disc: [15 + 3 * i, 15 + 3 * i + 1, 15 + 3 * i + 2],
-            direction: [1.0, 0.0, 0.0],
+            direction: [(0.3 + i as f64).cos(), (0.3 + i as f64).sin(), 0.0],
         })
         .collect();
     let eliminated: Vec<usize> = active.iter().map(|&i| pairs[i].pin[2]).collect();
@@ -595,6 +595,75 @@ fn tied_solves_through_the_free_factor_match_the_factorized_tied_stiffness() {
             .method
             .contains(&format!("{} tied pairs", active.len())));
     }
+}
+
+/// The friction load directions `U = T^T P~t^T` of the contact set `active`: `+e` on the
+/// pin's in-plane DOFs and `-e` on the disc's, one column per active pair.
+fn friction_loads(op: &FrictionalOperator, pairs: &[PairDofs], active: &[usize]) -> SparseMat {
+    let t = op.t.as_ref().unwrap();
+    let mut u = Mat::<f64>::zeros(op.dim(), active.len());
+    for (c, &i) in active.iter().enumerate() {
+        let p = &pairs[i];
+        for a in 0..2 {
+            u[(t[p.pin[a]], c)] += p.direction[a];
+            u[(t[p.disc[a]], c)] -= p.direction[a];
+        }
+    }
+    sparse(u.as_ref())
+}
+
+#[test]
+fn friction_statics_from_the_kept_free_responses_match_a_solve_of_the_loads() {
+    let (k, pairs, _, _) = tied_model(&[]);
+    let solves = pair_solves(&k, &pairs).unwrap();
+    // contact sets sharing pairs: the later ones find some responses kept, solve the rest
+    for active in [vec![0, 2], vec![0, 1, 2, 3], vec![3], vec![1, 2]] {
+        let (_, _, mut op, kc) = tied_model(&active);
+        op.friction_loads = Some(friction_loads(&op, &pairs, &active));
+        let (kept, reused) = StaticSolver::tied(&op, &solves)
+            .unwrap()
+            .friction_statics(&op)
+            .unwrap();
+        assert!(
+            reused,
+            "active {active:?}: the kept responses were not used"
+        );
+        let (solved, reused) = StaticSolver::new(&op, 0.0)
+            .unwrap()
+            .friction_statics(&op)
+            .unwrap();
+        assert!(!reused);
+        assert_eq!(kept.ncols(), active.len());
+        let scale = solved.norm_max();
+        assert!(scale > 0.0);
+        assert!(
+            (&kept - &solved).norm_max() <= 1e-12 * scale,
+            "active {active:?}: {:e} of {scale:e}",
+            (&kept - &solved).norm_max()
+        );
+        // and they are K_c's responses to the loads
+        let u = op.friction_loads.as_ref().unwrap().as_ref().to_dense();
+        let worst = (&(&kc * &kept) - &u).norm_max();
+        assert!(worst <= 1e-9, "active {active:?}: residual {worst:e}");
+    }
+    // a column that is not its pair's friction load is solved, not taken from the kept
+    // responses
+    let active = [0, 2];
+    let (_, _, mut op, _) = tied_model(&active);
+    let mut u = friction_loads(&op, &pairs, &active).as_ref().to_dense();
+    let t = op.t.clone().unwrap();
+    u[(t[pairs[2].pin[0]], 1)] *= 2.0;
+    op.friction_loads = Some(sparse(u.as_ref()));
+    let (x, reused) = StaticSolver::tied(&op, &solves)
+        .unwrap()
+        .friction_statics(&op)
+        .unwrap();
+    assert!(!reused);
+    let (y, _) = StaticSolver::new(&op, 0.0)
+        .unwrap()
+        .friction_statics(&op)
+        .unwrap();
+    assert!((&x - &y).norm_max() <= 1e-12 * y.norm_max());
 }
 
 #[test]

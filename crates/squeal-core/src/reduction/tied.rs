@@ -17,6 +17,13 @@
 //! free solve, one `n x nA` product and an `nA x nA` triangular pair, instead of a sparse
 //! factorization of its own `K_c`.
 //!
+//! The static responses to the friction loads (`K_c^-1 U`, one column per active pair,
+//! [`TiedSolve::friction_statics`]) need no solve of their own per contact set: a friction
+//! load `p_i` acts on in-plane DOFs, which no tie touches, so `T D^-1 U = P~t^T` and its
+//! free response `x_i = K^-1 p_i` is the same for every contact set that ties pair `i`.
+//! Each is solved once, the first time a contact set asks for it, and kept; a contact set
+//! then costs the correction onto its ties alone.
+//!
 //! Accuracy: the tied displacement is the difference of the free one and the ties'
 //! correction, so it carries their rounding: on the default rig at mu 0.3 the relative
 //! residuals `|K_c u_c - b_c| / |b_c|` of the `enriched` basis's solves are 4e-12 to
@@ -28,13 +35,15 @@
 use crate::contact::{FreeModel, ModelStage};
 use crate::linalg::{BlockSolve, Cholesky};
 use crate::operator::FrictionalOperator;
-use crate::{Error, Result};
+use crate::{Error, Result, SparseRef};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, Par, Side};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-/// Largest memory (bytes) the kept responses `Z` of the candidate pairs may take.
+/// Largest memory (bytes) the kept responses of the candidate pairs may take: `Z`, and
+/// the responses to their friction loads ([`TiedSolve::friction_statics`]) when they fit
+/// next to it.
 pub const PAIR_SOLVES_LIMIT_BYTES: usize = 4 << 30;
 
 /// The free model's responses to unit normal pair loads, kept for every contact set drawn
@@ -46,6 +55,11 @@ pub struct PairSolves {
     normals: Vec<(usize, usize)>,
     z: Mat<f64>,
     s: Mat<f64>,
+    /// In-plane DOFs of each candidate pair's pin and disc node and its sliding direction:
+    /// its friction load is `+e` on the pin's DOFs and `-e` on the disc's.
+    sliding: Vec<([usize; 2], [usize; 2], [f64; 2])>,
+    /// The responses `K^-1 p_i` to the friction loads of the pairs solved so far.
+    friction: Mutex<FrictionResponses>,
     /// Wall time of the construction (s), the factorization of `K` included when it was
     /// not given.
     pub time_s: f64,
@@ -95,15 +109,27 @@ impl PairSolves {
             )));
         }
         let mut normals = Vec::with_capacity(np);
+        let mut sliding = Vec::with_capacity(np);
         for (i, p) in free.pairs.iter().enumerate() {
-            let (a, b) = (p.pin[2], p.disc[2]);
-            if a >= n || b >= n || a == b {
+            if let Some(&d) = p.pin.iter().chain(&p.disc).find(|&&d| d >= n) {
                 return Err(Error::Invalid(format!(
-                    "tied solves: candidate pair {i} has normal DOFs ({a}, {b}) for a model of \
-                     {n} DOFs (expected two distinct DOFs below {n})"
+                    "tied solves: candidate pair {i} has DOF {d} for a model of {n} DOFs \
+                     (expected DOFs below {n})"
+                )));
+            }
+            let (a, b) = (p.pin[2], p.disc[2]);
+            if a == b {
+                return Err(Error::Invalid(format!(
+                    "tied solves: candidate pair {i} has one normal DOF {a} for pin and disc \
+                     (expected two distinct DOFs)"
                 )));
             }
             normals.push((a, b));
+            sliding.push((
+                [p.pin[0], p.pin[1]],
+                [p.disc[0], p.disc[1]],
+                [p.direction[0], p.direction[1]],
+            ));
         }
         let factor = match &free.k_factor {
             Some(f) if f.dim() == n => f.clone(),
@@ -131,8 +157,47 @@ impl PairSolves {
             normals,
             z,
             s,
+            sliding,
+            friction: Mutex::new(FrictionResponses {
+                x: Mat::new(),
+                solved: Vec::new(),
+            }),
             time_s: start.elapsed().as_secs_f64(),
         })
+    }
+
+    /// The free responses `K^-1 p_i` to the friction loads of the candidate pairs `pairs`
+    /// gathered into the columns of an `n x pairs.len()` block; the pairs met for the first
+    /// time are solved (one block solve) and kept. `None` when the kept responses would
+    /// pass [`PAIR_SOLVES_LIMIT_BYTES`] next to `Z`.
+    fn friction_responses(&self, pairs: &[usize]) -> Option<Mat<f64>> {
+        let (n, np) = (self.dim(), self.pairs());
+        let bytes = n.saturating_mul(np).saturating_mul(8);
+        if bytes.saturating_mul(2) > PAIR_SOLVES_LIMIT_BYTES {
+            return None;
+        }
+        let mut kept = self.friction.lock().unwrap_or_else(|p| p.into_inner());
+        if kept.x.nrows() != n {
+            kept.x = Mat::zeros(n, np);
+            kept.solved = vec![false; np];
+        }
+        let missing: Vec<usize> = pairs.iter().copied().filter(|&i| !kept.solved[i]).collect();
+        if !missing.is_empty() {
+            let mut loads = Mat::<f64>::zeros(n, missing.len());
+            for (c, &i) in missing.iter().enumerate() {
+                let (pin, disc, e) = self.sliding[i];
+                for a in 0..2 {
+                    loads[(pin[a], c)] += e[a];
+                    loads[(disc[a], c)] -= e[a];
+                }
+            }
+            self.factor.solve_in_place(loads.as_mut());
+            for (c, &i) in missing.iter().enumerate() {
+                kept.x.col_mut(i).copy_from(loads.col(c));
+                kept.solved[i] = true;
+            }
+        }
+        Some(Mat::from_fn(n, pairs.len(), |j, c| kept.x[(j, pairs[c])]))
     }
 
     /// Number of candidate pairs.
@@ -215,6 +280,14 @@ impl PairSolves {
     }
 }
 
+/// The kept responses to the candidate pairs' friction loads ([`PairSolves`]).
+struct FrictionResponses {
+    /// `K^-1 p_i` in column `i` (`n x np`, allocated at the first use).
+    x: Mat<f64>,
+    /// Which columns of `x` are solved.
+    solved: Vec<bool>,
+}
+
 /// Solves with `K_c` of one contact set through the free model's [`PairSolves`] (module
 /// docs).
 pub struct TiedSolve<'a> {
@@ -238,13 +311,56 @@ impl TiedSolve<'_> {
     }
 
     /// `B <- K_c^-1 B`.
-    pub fn solve(&self, mut b: MatMut<'_, f64>) {
+    pub fn solve(&self, b: MatMut<'_, f64>) {
         let (n, r) = (self.t.len(), b.ncols());
         let mut f = Mat::from_fn(n, r, |j, c| {
             let k = self.t[j];
             b[(k, c)] * self.inv_count[k]
         });
         self.solves.factor.solve_in_place(f.as_mut());
+        self.tie(f, b);
+    }
+
+    /// `K_c^-1 U` for the friction load directions `u` of the operator (`n_c x nA`, one
+    /// column per active pair, in the order of the candidate pairs), from the free model's
+    /// kept responses to the pairs' friction loads (module docs; the pairs no contact set
+    /// tied before are solved now). `None` when a column of `u` is not the friction load
+    /// of its pair or the kept responses would not fit ([`PAIR_SOLVES_LIMIT_BYTES`]): the
+    /// caller then solves `u`.
+    pub fn friction_statics(&self, u: SparseRef<'_>) -> Option<Mat<f64>> {
+        let na = self.active.len();
+        if u.ncols() != na || u.nrows() != self.rep.len() {
+            return None;
+        }
+        for (c, &i) in self.active.iter().enumerate() {
+            let (pin, disc, e) = self.solves.sliding[i];
+            let mut want: Vec<(usize, f64)> = (0..2)
+                .filter(|&a| e[a] != 0.0)
+                .flat_map(|a| [(self.t[pin[a]], e[a]), (self.t[disc[a]], -e[a])])
+                .collect();
+            want.sort_by_key(|w| w.0);
+            let rows = u.row_idx_of_col_raw(c);
+            let vals = u.val_of_col(c);
+            let same = rows.len() == want.len()
+                && rows
+                    .iter()
+                    .zip(vals)
+                    .zip(&want)
+                    .all(|((&r, &v), &(wr, wv))| r == wr && v == wv);
+            if !same {
+                return None;
+            }
+        }
+        let f = self.solves.friction_responses(&self.active)?;
+        let mut out = Mat::<f64>::zeros(self.rep.len(), na);
+        self.tie(f, out.as_mut());
+        Some(out)
+    }
+
+    /// The tied solution from the free one `f = K^-1 T D^-1 b` (the correction onto the
+    /// ties, module docs), written into `b` in the constrained numbering.
+    fn tie(&self, mut f: Mat<f64>, mut b: MatMut<'_, f64>) {
+        let r = f.ncols();
         let na = self.active.len();
         if na > 0 {
             let normals = &self.solves.normals;
