@@ -225,47 +225,17 @@ impl ReductionBasis for CmsBasis {
             ));
             return Ok(basis);
         }
-        let mut u;
-        if self.second_order {
-            let w;
-            (u, w) = free.expand_with_correction(&syn, &which)?;
-            let k = u.ncols();
-            u = Mat::from_fn(u.nrows(), 2 * k, |i, c| {
-                if c < k {
-                    u[(i, c)]
-                } else {
-                    w[(i, c - k)]
-                }
-            });
+        // the expanded modes (and their second-order directions), real and imaginary
+        // parts side by side
+        let blocks = if self.second_order {
+            let (u, w) = free.expand_parts_with_correction(&syn, &which)?;
+            vec![u, w]
         } else {
-            u = free.expand(&syn, &which);
-        }
+            vec![free.expand_parts(&syn, &which)]
+        };
         let t = op.t.as_ref().expect("checked by active_in");
-        let nc = op.dim();
-        let mut cols: Vec<Vec<f64>> = Vec::with_capacity(2 * which.len());
-        for c in 0..u.ncols() {
-            let scale = (0..u.nrows())
-                .map(|i| u[(i, c)].norm())
-                .fold(0.0f64, f64::max);
-            let im = (0..u.nrows())
-                .map(|i| u[(i, c)].im.abs())
-                .fold(0.0f64, f64::max);
-            for part in 0..2 {
-                if part == 1 && im <= 1e-8 * scale {
-                    continue;
-                }
-                let mut v = vec![0.0; nc];
-                for (j, &tj) in t.iter().enumerate() {
-                    v[tj] = if part == 0 {
-                        u[(j, c)].re
-                    } else {
-                        u[(j, c)].im
-                    };
-                }
-                cols.push(v);
-            }
-        }
-        let raw = Mat::from_fn(nc, cols.len(), |i, c| cols[c][i]);
+        let raw = constrained_columns(&blocks, which.len(), t, op.dim());
+        drop(blocks);
         let (v, dropped) = m_orthonormalize(op.mc.as_ref(), raw.as_ref(), self.rank_tol)?;
         let mut basis = Basis::new(v);
         basis.dropped = dropped;
@@ -282,4 +252,36 @@ impl ReductionBasis for CmsBasis {
         ));
         Ok(basis)
     }
+}
+
+/// The basis's candidate columns in the constrained numbering (`n_c` rows, `T` the index
+/// map): for each complex column `c` of each block (`k` columns, real parts in `0..k`,
+/// imaginary in `k..2k`), its real part, then its imaginary part unless that is below
+/// `1e-8` of the column's largest modulus (a real mode).
+fn constrained_columns(blocks: &[Mat<f64>], k: usize, t: &[usize], nc: usize) -> Mat<f64> {
+    let mut parts: Vec<(usize, usize)> = Vec::with_capacity(2 * k * blocks.len());
+    for (b, u) in blocks.iter().enumerate() {
+        for c in 0..k {
+            let (re, im) = (u.col(c), u.col(k + c));
+            let scale = re
+                .iter()
+                .zip(im.iter())
+                .map(|(a, b)| a.hypot(*b))
+                .fold(0.0f64, f64::max);
+            let imax = im.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            parts.push((b, c));
+            if imax > 1e-8 * scale {
+                parts.push((b, k + c));
+            }
+        }
+    }
+    let mut raw = Mat::<f64>::zeros(nc, parts.len());
+    for (col, &(b, c)) in parts.iter().enumerate() {
+        let src = blocks[b].col(c);
+        let mut dst = raw.col_mut(col);
+        for (j, &tj) in t.iter().enumerate() {
+            dst[tj] = src[j];
+        }
+    }
+    raw
 }

@@ -10,8 +10,13 @@ impl FreeInterface {
     /// The unconstrained displacements `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r` of the
     /// synthesized modes `which` (`n x which.len()`).
     pub fn expand(&self, syn: &Synthesized, which: &[usize]) -> Mat<c64> {
-        let (u, _) = self.combine(syn, which, false, None);
-        self.complex(&u, which.len())
+        self.complex(&self.expand_parts(syn, which), which.len())
+    }
+
+    /// [`FreeInterface::expand`] as real and imaginary parts side by side (`n x 2
+    /// which.len()`: column `c` real, `which.len() + c` imaginary).
+    pub fn expand_parts(&self, syn: &Synthesized, which: &[usize]) -> Mat<f64> {
+        self.combine(syn, which, false, None).0
     }
 
     /// [`FreeInterface::expand`] and [`FreeInterface::correction`] together: when the
@@ -22,9 +27,22 @@ impl FreeInterface {
         syn: &Synthesized,
         which: &[usize],
     ) -> Result<(Mat<c64>, Mat<c64>)> {
+        let (u, w) = self.expand_parts_with_correction(syn, which)?;
+        let k = which.len();
+        Ok((self.complex(&u, k), self.complex(&w, k)))
+    }
+
+    /// [`FreeInterface::expand_with_correction`] as real and imaginary parts side by side
+    /// ([`FreeInterface::expand_parts`]): no complex copies, for a caller that wants the
+    /// parts (the basis's columns).
+    pub fn expand_parts_with_correction(
+        &self,
+        syn: &Synthesized,
+        which: &[usize],
+    ) -> Result<(Mat<f64>, Mat<f64>)> {
         let (u, z) = self.combine(syn, which, false, None);
-        let w = self.correction_from(syn, which, z.as_ref())?;
-        Ok((self.complex(&u, which.len()), w))
+        let w = self.correction_parts(syn, which, z.as_ref())?;
+        Ok((u, w))
     }
 
     /// Real and imaginary parts side by side (`n x 2k`) to complex columns (`n x k`).
@@ -145,17 +163,18 @@ impl FreeInterface {
     /// (`n x which.len()`). Added to the expanded modes they let the Ritz step recover most
     /// of the residual inertia.
     pub fn correction(&self, syn: &Synthesized, which: &[usize]) -> Result<Mat<c64>> {
-        self.correction_from(syn, which, None)
+        let w = self.correction_parts(syn, which, None)?;
+        Ok(self.complex(&w, which.len()))
     }
 
-    /// [`FreeInterface::correction`], reusing the expansion's `K^-1 B_A^T r` if given.
-    fn correction_from(
+    /// [`FreeInterface::correction`] as real and imaginary parts side by side, reusing the
+    /// expansion's `K^-1 B_A^T r` if given.
+    fn correction_parts(
         &self,
         syn: &Synthesized,
         which: &[usize],
         reuse: Option<&Mat<f64>>,
-    ) -> Result<Mat<c64>> {
-        let n = self.dofs();
+    ) -> Result<Mat<f64>> {
         let nr = self.pairs();
         let na = syn.active.len();
         let k = which.len();
@@ -193,9 +212,7 @@ impl FreeInterface {
                 None => w -= &self.static_response(cf.as_ref(), 0.0),
             }
         }
-        Ok(Mat::from_fn(n, k, |i, c| {
-            c64::new(w[(i, c)], w[(i, k + c)])
-        }))
+        Ok(w)
     }
 }
 
