@@ -308,6 +308,42 @@ fn identity_and_full_rank_bases_reproduce_the_full_dense_spectrum() {
     }
 }
 
+#[test]
+fn symmetric_parts_project_by_their_lower_triangle_and_others_in_full() {
+    let op = operator(40, 4, true, 5);
+    let v = Rng(17).mat(40, 33);
+    // K_c and M_c are symmetric: the triangular product, mirrored, equals the full one
+    for x in [&op.kc, &op.mc] {
+        assert!(project::is_symmetric(x.as_ref()));
+        let sym = project::project_symmetric_part(x.as_ref(), v.as_ref())
+            .unwrap()
+            .as_ref()
+            .to_dense();
+        let full = project::project_part(x.as_ref(), v.as_ref())
+            .unwrap()
+            .as_ref()
+            .to_dense();
+        assert_eq!(sym, sym.transpose().to_owned());
+        let scale = full.norm_max();
+        assert!((&sym - &full).norm_max() <= 1e-13 * scale);
+    }
+    // a part that is not symmetric (one entry changed by one bit) takes the full product
+    let mut k = op.kc.as_ref().to_dense();
+    k[(3, 7)] = f64::from_bits(k[(3, 7)].to_bits() + 1);
+    let k = sparse(k.as_ref());
+    assert!(!project::is_symmetric(k.as_ref()));
+    let a = project::project_symmetric_part(k.as_ref(), v.as_ref())
+        .unwrap()
+        .as_ref()
+        .to_dense();
+    let b = project::project_part(k.as_ref(), v.as_ref())
+        .unwrap()
+        .as_ref()
+        .to_dense();
+    assert_eq!(a, b);
+    assert!(!project::is_symmetric(op.fk.as_ref()));
+}
+
 /// Every expanded mode has unit MAC with itself.
 fn mac_sanity(op: &FrictionalOperator, modes: &ComplexModes) -> bool {
     let n = op.dim();
