@@ -6,8 +6,9 @@
 #[allow(dead_code)]
 mod custom_basis;
 
-use squeal::analysis::bench::{bench_case, compare, speed_ratios, BenchOptions};
+use squeal::analysis::bench::{bench_case, compare, speed_ratios, stages_for, BenchOptions};
 use squeal::analysis::pipeline::Prepared;
+use squeal::core::reduction::PairSolves;
 use squeal::core::{c64, FrictionalOperator, Params};
 use squeal::scene::Scene;
 
@@ -191,4 +192,38 @@ fn bench_json_round_trips_failed_runs() {
         let (x, y) = (a.errors.max_rel_freq_err, b.errors.max_rel_freq_err);
         assert!(x == y || (x.is_nan() && y.is_nan()), "{x} vs {y}");
     }
+}
+
+#[test]
+fn a_model_stage_shared_by_two_bases_is_completed_before_any_case_is_timed() {
+    // `residue` prepares the pair solves, `enriched` (same stage key) completes them with
+    // the responses to every pair's friction load: no enriched case pays for them
+    let reg = squeal::registry();
+    let prep = Prepared::new(
+        &reg,
+        Scene::builtin("pin-on-disc-coarse").unwrap(),
+        "coarse",
+    )
+    .unwrap();
+    let set = squeal::contact::ContactSet::new(
+        &prep.model,
+        &squeal::scene::Zone::Uniform,
+        prep.scene.study.rotation,
+    )
+    .unwrap();
+    let mut opts = BenchOptions::all(&reg);
+    let mut pair_solves = |bases: &[&str]| {
+        opts.bases = bases.iter().map(|b| b.to_string()).collect();
+        let stages = stages_for(&reg, &opts, &prep.model, &set).unwrap();
+        assert_eq!(stages.len(), 1, "one stage for bases {bases:?}");
+        stages[0]
+            .stage
+            .downcast_ref::<PairSolves>()
+            .expect("the shared stage of residue and enriched is the pair solves")
+            .kept_friction_responses()
+    };
+    assert_eq!(pair_solves(&["residue", "enriched"]), set.len());
+    assert_eq!(pair_solves(&["enriched"]), set.len());
+    // residue alone needs none of them
+    assert_eq!(pair_solves(&["residue"]), 0);
 }

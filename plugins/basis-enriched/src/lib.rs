@@ -105,6 +105,15 @@ impl ReductionBasis for EnrichedBasis {
         PairSolves::stage(free)
     }
 
+    /// The responses to every candidate pair's friction load, solved now rather than at
+    /// the first contact set that ties each pair.
+    fn complete_stage(&self, stage: &ModelStage) -> Result<()> {
+        if let Some(pairs) = PairSolves::in_stage(Some(stage.as_ref())) {
+            pairs.solve_friction_responses();
+        }
+        Ok(())
+    }
+
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {
         let op = request.op;
         let mc = op.mc.as_ref();

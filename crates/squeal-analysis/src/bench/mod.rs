@@ -120,8 +120,10 @@ pub struct Stage {
 pub type Stages = Vec<Stage>;
 
 /// The model stages the bases of `opts` and their variants need (`cms`: the
-/// free-interface synthesis) on `model` and the candidate pairs `set`, one per stage key.
-/// Built once and handed to every [`bench_case`] of the model.
+/// free-interface synthesis) on `model` and the candidate pairs `set`, one per stage key,
+/// each completed by every basis that shares it
+/// ([`squeal_core::ReductionBasis::complete_stage`]). Built once and handed to every
+/// [`bench_case`] of the model.
 pub fn stages_for(
     registry: &Registry,
     opts: &BenchOptions,
@@ -139,7 +141,14 @@ pub fn stages_for(
             let Some(key) = plugin.stage_key(opts.band_hz[1]) else {
                 continue;
             };
-            if stages.iter().any(|s| s.key == key) {
+            if let Some(s) = stages.iter_mut().find(|s| s.key == key) {
+                // what this basis adds to a stage another one prepared: computed here, so
+                // that no case's set-up pays it
+                let t = Instant::now();
+                plugin
+                    .complete_stage(&s.stage)
+                    .map_err(core(format!("model stage of `{basis}`")))?;
+                s.time_s += t.elapsed().as_secs_f64();
                 continue;
             }
             let t = Instant::now();
@@ -155,6 +164,9 @@ pub fn stages_for(
                 &params,
             )?;
             if let Some(stage) = stage {
+                plugin
+                    .complete_stage(&stage)
+                    .map_err(core(format!("model stage of `{basis}`")))?;
                 stages.push(Stage {
                     key,
                     stage,

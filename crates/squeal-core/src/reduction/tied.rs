@@ -166,11 +166,27 @@ impl PairSolves {
         })
     }
 
+    /// How many candidate pairs' friction-load responses are kept.
+    pub fn kept_friction_responses(&self) -> usize {
+        let kept = self.friction.lock().unwrap_or_else(|p| p.into_inner());
+        kept.solved.iter().filter(|&&s| s).count()
+    }
+
+    /// Solves the free responses to the friction loads of every candidate pair not solved
+    /// yet (one block solve) and keeps them, so that no later contact set solves any
+    /// ([`TiedSolve::friction_statics`]); nothing when they would not fit
+    /// ([`PAIR_SOLVES_LIMIT_BYTES`]).
+    pub fn solve_friction_responses(&self) {
+        let all: Vec<usize> = (0..self.pairs()).collect();
+        let _ = self.friction_responses(&all, false);
+    }
+
     /// The free responses `K^-1 p_i` to the friction loads of the candidate pairs `pairs`
     /// gathered into the columns of an `n x pairs.len()` block; the pairs met for the first
     /// time are solved (one block solve) and kept. `None` when the kept responses would
     /// pass [`PAIR_SOLVES_LIMIT_BYTES`] next to `Z`.
-    fn friction_responses(&self, pairs: &[usize]) -> Option<Mat<f64>> {
+    /// When `gather` is false the pairs are solved and kept, and an empty block returned.
+    fn friction_responses(&self, pairs: &[usize], gather: bool) -> Option<Mat<f64>> {
         let (n, np) = (self.dim(), self.pairs());
         let bytes = n.saturating_mul(np).saturating_mul(8);
         if bytes.saturating_mul(2) > PAIR_SOLVES_LIMIT_BYTES {
@@ -196,6 +212,9 @@ impl PairSolves {
                 kept.x.col_mut(i).copy_from(loads.col(c));
                 kept.solved[i] = true;
             }
+        }
+        if !gather {
+            return Some(Mat::new());
         }
         Some(Mat::from_fn(n, pairs.len(), |j, c| kept.x[(j, pairs[c])]))
     }
@@ -351,7 +370,7 @@ impl TiedSolve<'_> {
                 return None;
             }
         }
-        let f = self.solves.friction_responses(&self.active)?;
+        let f = self.solves.friction_responses(&self.active, true)?;
         let mut out = Mat::<f64>::zeros(self.rep.len(), na);
         self.tie(f, out.as_mut());
         Some(out)
