@@ -158,10 +158,7 @@ impl PairSolves {
             z,
             s,
             sliding,
-            friction: Mutex::new(FrictionResponses {
-                x: Mat::new(),
-                solved: Vec::new(),
-            }),
+            friction: Mutex::new(FrictionResponses { x: Vec::new() }),
             time_s: start.elapsed().as_secs_f64(),
         })
     }
@@ -169,7 +166,7 @@ impl PairSolves {
     /// How many candidate pairs' friction-load responses are kept.
     pub fn kept_friction_responses(&self) -> usize {
         let kept = self.friction.lock().unwrap_or_else(|p| p.into_inner());
-        kept.solved.iter().filter(|&&s| s).count()
+        kept.x.iter().filter(|x| x.is_some()).count()
     }
 
     /// Solves the free responses to the friction loads of every candidate pair not solved
@@ -193,11 +190,15 @@ impl PairSolves {
             return None;
         }
         let mut kept = self.friction.lock().unwrap_or_else(|p| p.into_inner());
-        if kept.x.nrows() != n {
-            kept.x = Mat::zeros(n, np);
-            kept.solved = vec![false; np];
+        if kept.x.len() != np {
+            kept.x = vec![None; np];
         }
-        let missing: Vec<usize> = pairs.iter().copied().filter(|&i| !kept.solved[i]).collect();
+        let missing: Vec<usize> = pairs
+            .iter()
+            .copied()
+            .filter(|&i| kept.x[i].is_none())
+            .collect();
+        let mut solved = None;
         if !missing.is_empty() {
             let mut loads = Mat::<f64>::zeros(n, missing.len());
             for (c, &i) in missing.iter().enumerate() {
@@ -209,14 +210,23 @@ impl PairSolves {
             }
             self.factor.solve_in_place(loads.as_mut());
             for (c, &i) in missing.iter().enumerate() {
-                kept.x.col_mut(i).copy_from(loads.col(c));
-                kept.solved[i] = true;
+                let col = loads.col(c).try_as_col_major().unwrap().as_slice();
+                kept.x[i] = Some(col.into());
             }
+            solved = Some(loads);
         }
         if !gather {
             return Some(Mat::new());
         }
-        Some(Mat::from_fn(n, pairs.len(), |j, c| kept.x[(j, pairs[c])]))
+        // every pair solved now, in the order asked: the solved block is the answer
+        if missing == pairs {
+            return solved;
+        }
+        let cols: Vec<&[f64]> = pairs
+            .iter()
+            .map(|&i| kept.x[i].as_deref())
+            .collect::<Option<_>>()?;
+        Some(Mat::from_fn(n, pairs.len(), |j, c| cols[c][j]))
     }
 
     /// Number of candidate pairs.
@@ -301,10 +311,9 @@ impl PairSolves {
 
 /// The kept responses to the candidate pairs' friction loads ([`PairSolves`]).
 struct FrictionResponses {
-    /// `K^-1 p_i` in column `i` (`n x np`, allocated at the first use).
-    x: Mat<f64>,
-    /// Which columns of `x` are solved.
-    solved: Vec<bool>,
+    /// `K^-1 p_i` of each candidate pair `i`, once solved (`np` entries from the first
+    /// use).
+    x: Vec<Option<Box<[f64]>>>,
 }
 
 /// Solves with `K_c` of one contact set through the free model's [`PairSolves`] (module
