@@ -12,8 +12,12 @@ use squeal::core::reduction::PairSolves;
 use squeal::core::{c64, FrictionalOperator, Params};
 use squeal::scene::Scene;
 
+fn coarse(reg: &squeal::core::Registry) -> Prepared {
+    Prepared::new(reg, Scene::builtin("pin-on-disc-coarse").unwrap(), "coarse").unwrap()
+}
+
 fn coarse_operator(reg: &squeal::core::Registry, mu: f64) -> FrictionalOperator {
-    let prep = Prepared::new(reg, Scene::builtin("pin-on-disc-coarse").unwrap(), "coarse").unwrap();
+    let prep = coarse(reg);
     let eq = prep.equilibrium(reg, "lcp", "lagrange", mu).unwrap();
     prep.operator(&eq.eq.active).unwrap()
 }
@@ -199,12 +203,7 @@ fn a_model_stage_shared_by_two_bases_is_completed_before_any_case_is_timed() {
     // `residue` prepares the pair solves, `enriched` (same stage key) completes them with
     // the responses to every pair's friction load: no enriched case pays for them
     let reg = squeal::registry();
-    let prep = Prepared::new(
-        &reg,
-        Scene::builtin("pin-on-disc-coarse").unwrap(),
-        "coarse",
-    )
-    .unwrap();
+    let prep = coarse(&reg);
     let set = squeal::contact::ContactSet::new(
         &prep.model,
         &squeal::scene::Zone::Uniform,
