@@ -93,7 +93,7 @@ pub(super) fn is_symmetric(x: SparseRef<'_>) -> bool {
 /// the default rig (172k DOFs) the `enriched` bases of 200-460 columns projected 0.4 s
 /// faster with it, the 42-column `cms` bases 0.36 s slower (0.32 -> 0.68 s per point of
 /// the Figure 5 sweep of `squeal validate`).
-pub const SYMMETRIC_PROJECTION_MIN_COLUMNS: usize = 256;
+const SYMMETRIC_PROJECTION_MIN_COLUMNS: usize = 256;
 
 /// `V^T X V` for the mass and stiffness parts: when `X` is symmetric
 /// ([`is_symmetric`]) its lower triangle by one triangular product, mirrored (half the
@@ -129,8 +129,8 @@ pub(super) fn project_symmetric_part(x: SparseRef<'_>, v: MatRef<'_, f64>) -> Re
 
 /// Projects every part of `op` on the columns of `v` (`n_c x m`): `X_r = V^T X V`, the
 /// friction load directions to `V^T U`, no index map; the mass and stiffness parts of a
-/// basis of [`SYMMETRIC_PROJECTION_MIN_COLUMNS`] columns or more by
-/// [`project_symmetric_part`]. The result is a small (dense-backed) operator that any
+/// basis of 256 columns or more, when exactly symmetric, by their lower triangle (one
+/// triangular product, mirrored). The result is a small (dense-backed) operator that any
 /// [`EigenSolver`](crate::EigenSolver) solves.
 pub fn project(op: &FrictionalOperator, v: MatRef<'_, f64>) -> Result<FrictionalOperator> {
     let n = op.dim();
