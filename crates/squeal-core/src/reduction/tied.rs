@@ -38,7 +38,7 @@ use crate::operator::FrictionalOperator;
 use crate::{Error, Result, SparseRef};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, Par, Side};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Instant;
 
 /// Largest memory (bytes) the kept responses of the candidate pairs may take: `Z`, and
@@ -174,33 +174,40 @@ impl PairSolves {
     /// ([`TiedSolve::friction_statics`]); nothing when they would not fit
     /// ([`PAIR_SOLVES_LIMIT_BYTES`]).
     pub fn solve_friction_responses(&self) {
-        let all: Vec<usize> = (0..self.pairs()).collect();
-        let _ = self.friction_responses(&all, false);
+        if let Some(mut kept) = self.kept_responses() {
+            let all: Vec<usize> = (0..self.pairs()).collect();
+            self.solve_missing(&mut kept, &all);
+        }
     }
 
-    /// The free responses `K^-1 p_i` to the friction loads of the candidate pairs `pairs`
-    /// gathered into the columns of an `n x pairs.len()` block; the pairs met for the first
-    /// time are solved (one block solve) and kept. `None` when the kept responses would
-    /// pass [`PAIR_SOLVES_LIMIT_BYTES`] next to `Z`.
-    /// When `gather` is false the pairs are solved and kept, and an empty block returned.
-    fn friction_responses(&self, pairs: &[usize], gather: bool) -> Option<Mat<f64>> {
-        let (n, np) = (self.dim(), self.pairs());
-        let bytes = n.saturating_mul(np).saturating_mul(8);
+    /// The kept friction-load responses (sized for every candidate pair at the first
+    /// use), or `None` when they would pass [`PAIR_SOLVES_LIMIT_BYTES`] next to `Z`.
+    fn kept_responses(&self) -> Option<MutexGuard<'_, FrictionResponses>> {
+        let bytes = self.dim().saturating_mul(self.pairs()).saturating_mul(8);
         if bytes.saturating_mul(2) > PAIR_SOLVES_LIMIT_BYTES {
             return None;
         }
         let mut kept = self.friction.lock().unwrap_or_else(|p| p.into_inner());
-        if kept.x.len() != np {
-            kept.x = vec![None; np];
+        if kept.x.len() != self.pairs() {
+            kept.x = vec![None; self.pairs()];
         }
+        Some(kept)
+    }
+
+    /// Solves (one block solve) and keeps the responses of the pairs among `pairs` not
+    /// kept yet; returns those pairs and the solved block (`n x` their count).
+    fn solve_missing(
+        &self,
+        kept: &mut FrictionResponses,
+        pairs: &[usize],
+    ) -> (Vec<usize>, Mat<f64>) {
         let missing: Vec<usize> = pairs
             .iter()
             .copied()
             .filter(|&i| kept.x[i].is_none())
             .collect();
-        let mut solved = None;
+        let mut loads = Mat::<f64>::zeros(self.dim(), missing.len());
         if !missing.is_empty() {
-            let mut loads = Mat::<f64>::zeros(n, missing.len());
             for (c, &i) in missing.iter().enumerate() {
                 let (pin, disc, e) = self.sliding[i];
                 for a in 0..2 {
@@ -213,20 +220,26 @@ impl PairSolves {
                 let col = loads.col(c).try_as_col_major().unwrap().as_slice();
                 kept.x[i] = Some(col.into());
             }
-            solved = Some(loads);
         }
-        if !gather {
-            return Some(Mat::new());
-        }
+        (missing, loads)
+    }
+
+    /// The free responses `K^-1 p_i` to the friction loads of the candidate pairs `pairs`
+    /// gathered into the columns of an `n x pairs.len()` block; the pairs met for the first
+    /// time are solved (one block solve) and kept. `None` when the kept responses would
+    /// pass [`PAIR_SOLVES_LIMIT_BYTES`] next to `Z`.
+    fn friction_responses(&self, pairs: &[usize]) -> Option<Mat<f64>> {
+        let mut kept = self.kept_responses()?;
+        let (missing, solved) = self.solve_missing(&mut kept, pairs);
         // every pair solved now, in the order asked: the solved block is the answer
         if missing == pairs {
-            return solved;
+            return Some(solved);
         }
         let cols: Vec<&[f64]> = pairs
             .iter()
             .map(|&i| kept.x[i].as_deref())
             .collect::<Option<_>>()?;
-        Some(Mat::from_fn(n, pairs.len(), |j, c| cols[c][j]))
+        Some(Mat::from_fn(self.dim(), pairs.len(), |j, c| cols[c][j]))
     }
 
     /// Number of candidate pairs.
@@ -379,7 +392,7 @@ impl TiedSolve<'_> {
                 return None;
             }
         }
-        let f = self.solves.friction_responses(&self.active, true)?;
+        let f = self.solves.friction_responses(&self.active)?;
         let mut out = Mat::<f64>::zeros(self.rep.len(), na);
         self.tie(f, out.as_mut());
         Some(out)
