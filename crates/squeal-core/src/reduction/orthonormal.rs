@@ -207,19 +207,22 @@ struct Extension<'a> {
 }
 
 impl Extension<'_> {
-    /// Two block passes of `B` (with its image `MB` carried along) against the kept
-    /// columns `from..to`.
+    /// Two block passes of `B` against the kept columns `from..to`, its image `MB`
+    /// carried along: the coefficients `(M Q)^T B` need `B` only, so the image takes the
+    /// two passes' summed coefficients in one product (five `n x k x b` products instead
+    /// of six).
     fn project(&self, mut b: MatMut<'_, f64>, mut mb: MatMut<'_, f64>, from: usize, to: usize) {
         if to <= from {
             return;
         }
         let q = self.out.as_ref().subcols(from, to - from);
         let mq = self.mout.as_ref().subcols(from, to - from);
-        for _ in 0..2 {
-            let coef = tmul(mq, b.as_ref());
-            sub_mul(b.as_mut(), q, coef.as_ref());
-            sub_mul(mb.as_mut(), mq, coef.as_ref());
-        }
+        let mut total = tmul(mq, b.as_ref());
+        sub_mul(b.as_mut(), q, total.as_ref());
+        let coef = tmul(mq, b.as_ref());
+        sub_mul(b.as_mut(), q, coef.as_ref());
+        total += &coef;
+        sub_mul(mb.as_mut(), mq, total.as_ref());
     }
 
     /// Orthonormalizes the columns `lo..hi` of a block already projected against the
