@@ -1,7 +1,7 @@
 //! Bad input, table-driven: every case ends with exit code 1 or 2, one error line on
 //! stderr that names the option or field, and no output directory.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 /// The committed parametric operator (parameter `W` in [1, 100], friction part `FK`).
@@ -20,11 +20,12 @@ fn squeal() -> Command {
     Command::new(env!("CARGO_BIN_EXE_squeal"))
 }
 
-fn temp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("squeal-bad-input-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh directory under the system temp dir, removed when the guard drops.
+fn temp(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("squeal-bad-input-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 /// A copy of the coarse scene with `from` replaced by `to`.
@@ -83,7 +84,8 @@ fn refused(dir: &Path, args: &[&str], needles: &[&str]) {
 
 #[test]
 fn options_are_checked_before_any_work() {
-    let d = temp("options");
+    let tmp = temp("options");
+    let d = tmp.path();
     let cases: &[(&[&str], &[&str])] = &[
         (
             &["stability", "pin-on-disc-coarse", "--mu", "-1"],
@@ -371,13 +373,14 @@ fn options_are_checked_before_any_work() {
         ),
     ];
     for (args, needles) in cases {
-        refused(&d, args, needles);
+        refused(d, args, needles);
     }
 }
 
 #[test]
 fn scene_fields_are_named() {
-    let d = temp("scenes");
+    let tmp = temp("scenes");
+    let d = tmp.path();
     let cases = [
         (
             "nu.toml",
@@ -411,33 +414,34 @@ fn scene_fields_are_named() {
         ),
     ];
     for (name, from, to, needles) in cases {
-        let s = scene_with(&d, name, from, to);
-        refused(&d, &["scene", "info", &s], needles);
+        let s = scene_with(d, name, from, to);
+        refused(d, &["scene", "info", &s], needles);
     }
     // a shear modulus given as the scene names it
     let s = scene_with(
-        &d,
+        d,
         "g.toml",
         "youngs_modulus_axial_pa = 5400000000.0",
         "youngs_modulus_axial_pa = 5400000000.0, shear_modulus_axial_pa = -1.0",
     );
-    refused(&d, &["scene", "info", &s], &["shear_modulus_axial_pa"]);
+    refused(d, &["scene", "info", &s], &["shear_modulus_axial_pa"]);
 }
 
 #[test]
 fn output_directories_belong_to_one_command() {
-    let d = temp("out");
+    let tmp = temp("out");
+    let d = tmp.path();
     // --out naming a file
     std::fs::write(d.join("afile"), "x").unwrap();
     refused(
-        &d,
+        d,
         &["equilibrium", "pin-on-disc-coarse", "--out", "afile"],
         &["--out afile", "is a file"],
     );
     // a sweep's directory refused to a study, and a finished sweep without --resume
     let sweep = d.join("sweep");
     let o = squeal()
-        .current_dir(&d)
+        .current_dir(d)
         .args([
             "sweep",
             "mu",
@@ -454,12 +458,12 @@ fn output_directories_belong_to_one_command() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let s = sweep.display().to_string();
     refused(
-        &d,
+        d,
         &["sweep", "macro", "pin-on-disc-coarse", "--out", &s],
         &["holds the output of `squeal sweep mu`"],
     );
     refused(
-        &d,
+        d,
         &[
             "sweep",
             "mu",
@@ -475,7 +479,7 @@ fn output_directories_belong_to_one_command() {
     );
     // with --resume it finishes
     let o = squeal()
-        .current_dir(&d)
+        .current_dir(d)
         .args([
             "sweep",
             "mu",
@@ -496,7 +500,8 @@ fn output_directories_belong_to_one_command() {
 
 #[test]
 fn operators_read_from_files_are_checked() {
-    let d = temp("operator");
+    let tmp = temp("operator");
+    let d = tmp.path();
     let dir = d.join("op");
     let o = squeal()
         .args(["export", "pin-on-disc-coarse", "--mu", "0.3", "--out"])
@@ -527,7 +532,7 @@ fn operators_read_from_files_are_checked() {
     std::fs::write(&mc, negated + "\n").unwrap();
     let op = dir.display().to_string();
     refused(
-        &d,
+        d,
         &["stability", "--operator", &op, "--mu", "0.3"],
         &["--operator", "M_c", "diagonal"],
     );

@@ -2,29 +2,19 @@
 //! expected marks; bad input gives a `PlotError` naming the output and writes nothing.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use squeal_plot::{
     bar_chart, contact_map, contact_map_size, layout_map, line_chart, pareto_chart, pareto_front,
     ChartOptions, MapPanel, PlotError, Series, SeriesStyle, CHART_SIZE,
 };
 
-/// A fresh directory under the system temp dir (never the repository).
-fn temp_dir(name: &str) -> PathBuf {
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
+/// A fresh directory under the system temp dir (never the repository), removed when the
+/// guard drops.
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("squeal-plot-test-{name}-"))
+        .tempdir()
         .unwrap()
-        .as_nanos();
-    let dir = std::env::temp_dir().join(format!(
-        "squeal-plot-test-{}-{}-{}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::SeqCst),
-        nanos,
-        name
-    ));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 /// Parsed SVG text plus helpers to count elements.
@@ -150,7 +140,8 @@ fn grid_panel(title: &str, nx: usize, ny: usize) -> MapPanel {
 
 #[test]
 fn contact_map_writes_svg_and_png_with_one_rect_per_pair() {
-    let dir = temp_dir("contact");
+    let tmp = temp_dir("contact");
+    let dir = tmp.path();
     let stem = dir.join("map");
     let panels = [grid_panel("set A", 10, 4), grid_panel("set B", 6, 5)];
     let files = contact_map(&stem, "Contact map title", "normal force (N)", &panels).unwrap();
@@ -188,7 +179,8 @@ fn text_boxes(svg: &Svg) -> Vec<(String, f64, f64)> {
 
 #[test]
 fn contact_map_texts_do_not_overlap() {
-    let dir = temp_dir("contact-texts");
+    let tmp = temp_dir("contact-texts");
+    let dir = tmp.path();
     let stem = dir.join("map");
     let long = "mu = 0.36, ~2100 Hz (+-20 %): 12 zones (30/36 cases solved)";
     // values up to 12345: wide tick labels on the colour bar
@@ -232,7 +224,8 @@ fn contact_map_texts_do_not_overlap() {
 
 #[test]
 fn contact_map_grid_beyond_three_panels() {
-    let dir = temp_dir("contact-grid");
+    let tmp = temp_dir("contact-grid");
+    let dir = tmp.path();
     let stem = dir.join("nested/dir/map"); // parent directories are created
     let panels: Vec<MapPanel> = (0..5)
         .map(|k| MapPanel {
@@ -249,7 +242,8 @@ fn contact_map_grid_beyond_three_panels() {
 
 #[test]
 fn contact_map_bad_input() {
-    let dir = temp_dir("contact-bad");
+    let tmp = temp_dir("contact-bad");
+    let dir = tmp.path();
     let stem = dir.join("map");
     let err = contact_map(&stem, "t", "v", &[]).unwrap_err();
     assert!(matches!(err, PlotError::EmptyData { .. }), "{err}");
@@ -303,7 +297,8 @@ fn contact_map_bad_input() {
 
 #[test]
 fn layout_map_draws_two_colours_and_explicit_cells() {
-    let dir = temp_dir("layout");
+    let tmp = temp_dir("layout");
+    let dir = tmp.path();
     let stem = dir.join("layouts");
     // A refined corner: pairs of a 3 x 3 grid whose first column and row are 0.2 mm wide
     // and the rest 1 mm, drawn with their own rectangles; values 0/1 alternate.
@@ -366,7 +361,8 @@ fn curve() -> Series {
 
 #[test]
 fn line_chart_markers_highlights_and_lines() {
-    let dir = temp_dir("line");
+    let tmp = temp_dir("line");
+    let dir = tmp.path();
     let stem = dir.join("stability");
     let opts = ChartOptions {
         hline: Some(0.0),
@@ -403,7 +399,8 @@ fn line_chart_markers_highlights_and_lines() {
 
 #[test]
 fn line_chart_custom_size_and_line_markers() {
-    let dir = temp_dir("line-size");
+    let tmp = temp_dir("line-size");
+    let dir = tmp.path();
     let stem = dir.join("conv");
     let s = Series {
         name: String::new(), // no legend
@@ -425,7 +422,8 @@ fn line_chart_custom_size_and_line_markers() {
 
 #[test]
 fn line_chart_log_axes_drop_non_positive_points() {
-    let dir = temp_dir("line-log");
+    let tmp = temp_dir("line-log");
+    let dir = tmp.path();
     let stem = dir.join("loglog");
     let s = Series {
         name: "s".into(),
@@ -472,7 +470,8 @@ fn line_chart_log_axes_drop_non_positive_points() {
 
 #[test]
 fn line_chart_bad_input() {
-    let dir = temp_dir("line-bad");
+    let tmp = temp_dir("line-bad");
+    let dir = tmp.path();
     let stem = dir.join("c");
     let o = ChartOptions::default();
     let err = line_chart(&stem, "t", "x", "y", &[], &o).unwrap_err();
@@ -529,7 +528,8 @@ fn pareto_front_selection() {
 
 #[test]
 fn pareto_chart_marks_front_and_labels() {
-    let dir = temp_dir("pareto");
+    let tmp = temp_dir("pareto");
+    let dir = tmp.path();
     let stem = dir.join("pareto");
     let mut pts = methods();
     pts.push(("free lunch?".into(), 0.0, 1e-3)); // not on a log axis: dropped
@@ -579,7 +579,8 @@ fn pareto_chart_many_clustered_methods_stay_apart() {
     // 24 methods with nearly equal time and error (a cluster, as the solvers of one
     // reduced problem give): every one a distinct colour, every name in the legend beside
     // the plot area, none written over the points
-    let dir = temp_dir("pareto-many");
+    let tmp = temp_dir("pareto-many");
+    let dir = tmp.path();
     let stem = dir.join("pareto");
     let pts: Vec<(String, f64, f64)> = (0..24)
         .map(|k| {
@@ -621,7 +622,8 @@ fn pareto_chart_many_clustered_methods_stay_apart() {
 
 #[test]
 fn pareto_chart_bad_input() {
-    let dir = temp_dir("pareto-bad");
+    let tmp = temp_dir("pareto-bad");
+    let dir = tmp.path();
     let stem = dir.join("p");
     let err = pareto_chart(&stem, "t", "x", "y", &[]).unwrap_err();
     assert!(matches!(err, PlotError::EmptyData { .. }), "{err}");
@@ -639,7 +641,8 @@ fn pareto_chart_bad_input() {
 
 #[test]
 fn bar_chart_one_rect_per_bar() {
-    let dir = temp_dir("bars");
+    let tmp = temp_dir("bars");
+    let dir = tmp.path();
     let stem = dir.join("timings");
     let bars: Vec<(String, f64)> = [
         ("assembly", 1.5),
@@ -663,7 +666,8 @@ fn bar_chart_one_rect_per_bar() {
 
 #[test]
 fn bar_chart_bad_input() {
-    let dir = temp_dir("bars-bad");
+    let tmp = temp_dir("bars-bad");
+    let dir = tmp.path();
     let stem = dir.join("b");
     let err = bar_chart(&stem, "t", "x", "y", &[]).unwrap_err();
     assert!(matches!(err, PlotError::EmptyData { .. }), "{err}");
@@ -675,7 +679,8 @@ fn bar_chart_bad_input() {
 
 #[test]
 fn unwritable_output_is_an_io_error_naming_the_path() {
-    let dir = temp_dir("io");
+    let tmp = temp_dir("io");
+    let dir = tmp.path();
     // A regular file where the output directory should be.
     let blocker = dir.join("not-a-dir");
     std::fs::write(&blocker, b"x").unwrap();
