@@ -42,7 +42,7 @@ impl SceneCmd {
 /// Measured wall times of `squeal validate` (its default check step) on a 2-core machine,
 /// `(free DOFs, seconds)`, by size: the embedded `pin-on-disc-coarse`, `pin-on-disc` and
 /// `pin-on-disc-paper` scenes. They calibrate [`validate_estimate_s`].
-const VALIDATE_RUNS: [(f64, f64); 3] = [(1_779.0, 3.6), (171_963.0, 940.0), (330_306.0, 2_505.0)];
+const VALIDATE_RUNS: [(f64, f64); 3] = [(1_779.0, 3.2), (171_963.0, 981.0), (330_306.0, 2_354.0)];
 
 /// Exponent of the power law `t = t0 (n / n0)^p` between measured runs `i` and `i + 1`.
 fn segment_exponent(i: usize) -> f64 {
