@@ -16,10 +16,12 @@ pub const DEFAULT_RANK_TOL: f64 = 1e-10;
 /// Columns orthonormalized together (BLAS-3 projections against the kept columns).
 const BLOCK: usize = 32;
 
-/// `M` norm (of a column that started at 1) below which its `M` image is recomputed by a
-/// sparse product rather than carried through the projections: the carried image has an
-/// absolute error of a few roundoffs, so its relative error stays below about 1e-12 above
-/// this.
+/// Fraction of the `M` norm at which a column's `M` image was last exact (1 for a column
+/// that started at unit norm) below which the image is recomputed by a sparse product
+/// rather than carried through the projections: the carried image has an absolute error
+/// of a few roundoffs of that norm, so its relative error stays below about 1e-12 above
+/// this. Columns that a block pass leaves short are recomputed together, in one sparse
+/// product of the block.
 const RECOMPUTE_BELOW: f64 = 1e-3;
 
 /// `Y -= A B` for dense matrices.
@@ -161,6 +163,8 @@ pub(crate) fn m_orthonormal_extend_in_place(
             mblk.col_mut(c).iter_mut().for_each(|x| *x *= s);
         }
         ext.project(blk.as_mut(), mblk.as_mut(), 0, ext.k);
+        let mut exact = vec![1.0; b];
+        ext.refresh(&blk, &mut mblk, &alive, &mut exact, 0, b);
         // the norm each column keeps outside the earlier blocks (it started at 1)
         let mut before = vec![0.0; b];
         for c in 0..b {
@@ -172,7 +176,7 @@ pub(crate) fn m_orthonormal_extend_in_place(
                 ext.dropped += 1;
             }
         }
-        ext.within(&mut blk, &mut mblk, &alive, &before, 0, b);
+        ext.within(&mut blk, &mut mblk, (&alive, &before, &mut exact), 0, b);
         c0 += b;
     }
     let Extension {
@@ -225,57 +229,92 @@ impl Extension<'_> {
         sub_mul(mb.as_mut(), mq, total.as_ref());
     }
 
+    /// After a block pass over the columns `lo..hi`: the live columns whose carried image
+    /// lost more than [`RECOMPUTE_BELOW`] of the norm at which it was exact (`exact`) get
+    /// their images recomputed, all in one sparse product, and `exact` their norms now.
+    fn refresh(
+        &self,
+        blk: &Mat<f64>,
+        mblk: &mut Mat<f64>,
+        alive: &[bool],
+        exact: &mut [f64],
+        lo: usize,
+        hi: usize,
+    ) {
+        let short: Vec<usize> = (lo..hi)
+            .filter(|&c| {
+                alive[c]
+                    && dot(col(blk, c), col(mblk, c)).max(0.0).sqrt() < RECOMPUTE_BELOW * exact[c]
+            })
+            .collect();
+        if short.is_empty() {
+            return;
+        }
+        let x = Mat::from_fn(blk.nrows(), short.len(), |i, j| blk[(i, short[j])]);
+        let mx = symmetric_times(self.m, x.as_ref());
+        for (j, &c) in short.iter().enumerate() {
+            mblk.col_mut(c).copy_from(mx.col(j));
+            exact[c] = dot(col(blk, c), col(mblk, c)).max(0.0).sqrt();
+        }
+    }
+
     /// Orthonormalizes the columns `lo..hi` of a block already projected against the
     /// earlier blocks, in order, recursively: the left half, then the right half projected
-    /// against what the left half kept (block passes), then the right half; a leaf of
-    /// [`LEAF`] columns goes column by column. The block passes read each column of the
-    /// block a logarithmic number of times instead of once per later column.
+    /// against what the left half kept (block passes, the images they leave short
+    /// recomputed together), then the right half; a leaf of [`LEAF`] columns goes column
+    /// by column. The block passes read each column of the block a logarithmic number of
+    /// times instead of once per later column. `state`: which columns are alive, their
+    /// norms after the passes against the earlier blocks, and the norms at which their
+    /// images were last exact.
     fn within(
         &mut self,
         blk: &mut Mat<f64>,
         mblk: &mut Mat<f64>,
-        alive: &[bool],
-        before: &[f64],
+        state: (&[bool], &[f64], &mut [f64]),
         lo: usize,
         hi: usize,
     ) {
+        let (alive, before, exact) = state;
         if hi - lo <= LEAF {
             let k_leaf = self.k;
             for c in lo..hi {
                 if alive[c] {
-                    self.column(col(blk, c), col(mblk, c), before[c], k_leaf);
+                    self.column(col(blk, c), col(mblk, c), (before[c], exact[c]), k_leaf);
                 }
             }
             return;
         }
         let mid = lo + (hi - lo) / 2;
         let k_left = self.k;
-        self.within(blk, mblk, alive, before, lo, mid);
+        self.within(blk, mblk, (alive, before, &mut *exact), lo, mid);
         self.project(
             blk.as_mut().subcols_mut(mid, hi - mid),
             mblk.as_mut().subcols_mut(mid, hi - mid),
             k_left,
             self.k,
         );
-        self.within(blk, mblk, alive, before, mid, hi);
+        self.refresh(blk, mblk, alive, exact, mid, hi);
+        self.within(blk, mblk, (alive, before, exact), mid, hi);
     }
 
-    /// Projects one column (its `M` norm was `before` after the block passes against the
-    /// earlier blocks) against the kept columns `k_leaf..k` of its leaf, twice, and keeps
-    /// it unless it falls under the rank cut. Heavy cancellation inside the block (less
-    /// than a tenth of `before` left) earns one more pass against every kept column.
-    fn column(&mut self, v: &[f64], mv: &[f64], before: f64, k_leaf: usize) {
+    /// Projects one column against the kept columns `k_leaf..k` of its leaf, twice, and
+    /// keeps it unless it falls under the rank cut; `norms`: its `M` norm after the block
+    /// passes against the earlier blocks, and the norm at which its image was last exact.
+    /// Heavy cancellation inside the block (less than a tenth of the first left) earns
+    /// one more pass against every kept column.
+    fn column(&mut self, v: &[f64], mv: &[f64], norms: (f64, f64), k_leaf: usize) {
         // `mw = M w` is carried through the projections (`M (w - Q c) = M w - (M Q) c`)
         // instead of one sparse product per pass; it is recomputed exactly only when
-        // cancellation left `w` short (below RECOMPUTE_BELOW of the unit norm it started
-        // from), where the carried product's relative error would grow
+        // cancellation left `w` short (below RECOMPUTE_BELOW of the norm at which the
+        // image was last exact), where the carried product's relative error would grow
+        let (before, mut exact) = norms;
         let mut w = std::mem::take(&mut self.w);
         let mut mw = std::mem::take(&mut self.mw);
         w.copy_from_slice(v);
         mw.copy_from_slice(mv);
-        let mut nrm = self.passes(&mut w, &mut mw, k_leaf);
+        let mut nrm = self.passes(&mut w, &mut mw, k_leaf, &mut exact);
         if nrm < 0.1 * before {
-            nrm = self.passes(&mut w, &mut mw, 0);
+            nrm = self.passes(&mut w, &mut mw, 0, &mut exact);
         }
         if nrm >= self.rank_tol && nrm.is_finite() {
             let k = self.k;
@@ -291,9 +330,9 @@ impl Extension<'_> {
         self.mw = mw;
     }
 
-    /// Two passes of `w` (image `mw`) against the kept columns `from..k`; returns the
-    /// `M` norm left.
-    fn passes(&self, w: &mut [f64], mw: &mut [f64], from: usize) -> f64 {
+    /// Two passes of `w` (image `mw`, exact at the norm `exact`, which a recomputation
+    /// updates) against the kept columns `from..k`; returns the `M` norm left.
+    fn passes(&self, w: &mut [f64], mw: &mut [f64], from: usize, exact: &mut f64) -> f64 {
         let n = w.len();
         self.project(
             MatMut::from_column_major_slice_mut(w, n, 1),
@@ -301,8 +340,9 @@ impl Extension<'_> {
             from,
             self.k,
         );
-        if dot(w, mw).max(0.0).sqrt() < RECOMPUTE_BELOW {
+        if dot(w, mw).max(0.0).sqrt() < RECOMPUTE_BELOW * *exact {
             spmv(self.m, w, mw);
+            *exact = dot(w, mw).max(0.0).sqrt();
         }
         dot(w, mw).max(0.0).sqrt()
     }

@@ -88,6 +88,16 @@ impl FreeInterface {
                 coef[(j, k + c)] = e.im;
             }
         }
+        // only the columns with a nonzero coefficient are formed: a synthesized mode at a
+        // real root `s` (most of them: the undamped synthesis is real) has zero imaginary
+        // parts, so half of the products and solves would be on zeros
+        let live: Vec<usize> = (0..2 * k)
+            .filter(|&c| {
+                (0..nm).any(|j| coef[(j, c)] != 0.0)
+                    || (0..self.pairs()).any(|i| rfull[(i, c)] != 0.0)
+            })
+            .collect();
+        let (coef, rfull) = (select(coef.as_ref(), &live), select(rfull.as_ref(), &live));
         // K^-1 B^T r, or K^-1 M K^-1 B^T r
         let mut first = None;
         let mut u = match self
@@ -110,7 +120,7 @@ impl FreeInterface {
             }
             None => {
                 let z = match reuse {
-                    Some(z) => z.clone(),
+                    Some(z) => select(z.as_ref(), &live),
                     None => self.static_response(rfull.as_ref(), mu),
                 };
                 if second {
@@ -132,12 +142,22 @@ impl FreeInterface {
             1.0,
             par(),
         );
-        (u, first)
+        let width = 2 * k;
+        (
+            scatter(u, &live, width),
+            first.map(|f| scatter(f, &live, width)),
+        )
     }
 
     /// `K^-1 (Pn^T + mu Pt^T) r` for the pair loads `r` (`nR x c`, N): `n x c` (m), from
-    /// the stored responses when there are, else by a block solve.
+    /// the stored responses when there are, else by a block solve; the zero columns of
+    /// `r` are left out of the products and solves.
     fn static_response(&self, r: MatRef<'_, f64>, mu: f64) -> Mat<f64> {
+        let live = live_columns(r);
+        if live.len() < r.ncols() {
+            let x = self.static_response(select(r, &live).as_ref(), mu);
+            return scatter(x, &live, r.ncols());
+        }
         if let Some(st) = &self.stored {
             return combined(&st.zn, &st.zt, r, mu);
         }
@@ -200,20 +220,35 @@ impl FreeInterface {
                     cf[(i, c)] = cfix[(row, c)];
                 }
             }
-            match &self.stored {
-                Some(st) => matmul(
-                    w.as_mut(),
-                    Accum::Add,
-                    st.zn.as_ref(),
-                    cf.as_ref(),
-                    -1.0,
-                    par(),
-                ),
-                None => w -= &self.static_response(cf.as_ref(), 0.0),
-            }
+            w -= &self.static_response(cf.as_ref(), 0.0);
         }
         Ok(w)
     }
+}
+
+/// The columns of `x` with a nonzero entry.
+fn live_columns(x: MatRef<'_, f64>) -> Vec<usize> {
+    (0..x.ncols())
+        .filter(|&c| x.col(c).iter().any(|&v| v != 0.0))
+        .collect()
+}
+
+/// The columns `cols` of `x`.
+fn select(x: MatRef<'_, f64>, cols: &[usize]) -> Mat<f64> {
+    Mat::from_fn(x.nrows(), cols.len(), |i, j| x[(i, cols[j])])
+}
+
+/// `x` (one column per entry of `cols`) as the columns `cols` of a matrix of `width`
+/// columns, the others zero.
+fn scatter(x: Mat<f64>, cols: &[usize], width: usize) -> Mat<f64> {
+    if cols.len() == width {
+        return x;
+    }
+    let mut out = Mat::<f64>::zeros(x.nrows(), width);
+    for (j, &c) in cols.iter().enumerate() {
+        out.col_mut(c).copy_from(x.col(j));
+    }
+    out
 }
 
 /// `(Yn + mu Yt) r` from stored responses (`n x nR` each) and pair loads `r` (`nR x c`).
