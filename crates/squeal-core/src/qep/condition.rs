@@ -454,36 +454,24 @@ pub(super) fn condition_numbers(
     left: MatRef<'_, c64>,
     eta: &[f64],
 ) -> (Vec<f64>, Vec<f64>) {
-    use super::residual::{at, in_two_halves, interleave, terms_times};
-    let n = q.n;
-    // y^H Q'(lambda) x = y^H (2 lambda M x + C x) for all pairs, one pass over each matrix
-    // per block of columns
-    let pairs = in_two_halves(lambda.len(), |lo, hi| {
-        let w = hi - lo;
-        let x = interleave(right, lo, hi);
-        let mx = terms_times(n, &q.m, &x, w);
-        let cx = (!q.c.is_empty()).then(|| terms_times(n, &q.c, &x, w));
-        (lo..hi)
-            .map(|j| {
-                let c = j - lo;
-                let (mut d, mut nx, mut ny) = (c64::new(0.0, 0.0), 0.0f64, 0.0f64);
-                for r in 0..n {
-                    let mut t = at(&mx, w, r, c) * (lambda[j] * 2.0);
-                    if let Some(cx) = &cx {
-                        t += at(cx, w, r, c);
-                    }
-                    d += left[(r, j)].conj() * t;
-                    nx += right[(r, j)].norm_sqr();
-                    ny += left[(r, j)].norm_sqr();
-                }
-                (d.norm(), nx.sqrt(), ny.sqrt())
-            })
-            .collect()
-    });
+    let (_, products) = super::residual::check_pairs(q, norms, lambda, right, Some(left), false);
+    condition_from_products(norms, lambda, &products, eta)
+}
+
+/// [`condition_numbers`] from the pairs' [`DerivativeProducts`]
+/// (`|y^H Q'(lambda) x|`, `||x||`, `||y||`, [`super::residual::check_pairs`]).
+///
+/// [`DerivativeProducts`]: super::residual::DerivativeProducts
+pub(super) fn condition_from_products(
+    norms: &super::residual::QepNorms,
+    lambda: &[c64],
+    products: &[super::residual::DerivativeProducts],
+    eta: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
     let mut cond = Vec::with_capacity(lambda.len());
     let mut bound = Vec::with_capacity(lambda.len());
     for (j, &l) in lambda.iter().enumerate() {
-        let (d, nx, ny) = pairs[j];
+        let (d, nx, ny) = products[j];
         let al = l.norm();
         let w = al * al * norms.m + al * norms.c + norms.k;
         let c = if !(ny.is_finite() && ny > 0.0) || al == 0.0 {

@@ -4,7 +4,7 @@
 //! ([`add_condition`]).
 
 use super::condition::{self, LeftSource};
-use super::residual::{backward_errors, QepTerms};
+use super::residual::{check_pairs, QepTerms};
 use super::{left_eigenvectors, Condition};
 use crate::eigen::EigenParams;
 use crate::linalg::norm2_c;
@@ -251,7 +251,6 @@ fn finish_terms(
         freq.push(f);
         dvr.push(l.re / l.im);
     }
-    let be = backward_errors(qep, &norms, &lam, out.as_ref());
     let left = match left {
         LeftSource::None => None,
         LeftSource::Given(y) => Some(Mat::from_fn(n, keep.len(), |r, c| y[(r, keep[c].1)])),
@@ -275,8 +274,17 @@ fn finish_terms(
             Some(y)
         }
     };
+    // one pass over the matrices for the backward errors and the condition numbers
+    let (be, products) = check_pairs(
+        qep,
+        &norms,
+        &lam,
+        out.as_ref(),
+        left.as_ref().map(|y| y.as_ref()),
+        true,
+    );
     let (cond, error_bound) = match &left {
-        Some(y) => condition::condition_numbers(qep, &norms, &lam, out.as_ref(), y.as_ref(), &be),
+        Some(_) => condition::condition_from_products(&norms, &lam, &products, &be),
         None => (vec![f64::NAN; lam.len()], vec![f64::NAN; lam.len()]),
     };
     Ok(ComplexModes {

@@ -83,6 +83,16 @@ impl<'a> QepTerms<'a> {
                 let mut touched = Vec::new();
                 let mut best = 0.0f64;
                 for j in 0..self.n {
+                    // a column only one term has entries in (all but the pairs' columns
+                    // of the friction parts): its sum directly, the same bits
+                    let mut with = terms
+                        .iter()
+                        .filter(|(a, _)| !a.row_idx_of_col_raw(j).is_empty());
+                    if let (Some((a, s)), None) = (with.next(), with.next()) {
+                        let sum: f64 = a.val_of_col(j).iter().map(|v| (s * v).abs()).sum();
+                        best = best.max(sum);
+                        continue;
+                    }
                     for (a, s) in terms {
                         for (&i, &v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
                             if acc[i] == 0.0 {
@@ -125,39 +135,87 @@ pub(super) fn backward_error_with(qep: &Qep, norms: &QepNorms, lambda: c64, u: &
 }
 
 /// Backward errors of the pairs `(lambda[j], u[:, j])` on `qep`, the same numbers as
-/// [`backward_error`] one by one, from one pass over each matrix for all vectors at once
-/// (real and imaginary parts as `2 k` right-hand sides stored row by row, so every
-/// nonzero updates a contiguous row) instead of `2 k` serial sparse products: the per-mu
-/// cost of reduced solves is dominated by this check. The right-hand sides are split
-/// between two threads.
+/// [`backward_error`] one by one ([`check_pairs`] without left vectors).
+#[cfg(test)]
 pub(super) fn backward_errors(
     qep: &QepTerms<'_>,
     norms: &QepNorms,
     lambda: &[c64],
     u: MatRef<'_, c64>,
 ) -> Vec<f64> {
+    check_pairs(qep, norms, lambda, u, None, true).0
+}
+
+/// `|y^H Q'(lambda) x|`, `||x||`, `||y||` of one pair with its left vector `y`
+/// (`Q'(lambda) = 2 lambda M + C`): what its condition number needs.
+pub(super) type DerivativeProducts = (f64, f64, f64);
+
+/// The backward errors of the pairs `(lambda[j], u[:, j])` on `qep` (when `backward`;
+/// else empty) and, with their left vectors `left`, the [`DerivativeProducts`] of each,
+/// from one pass over each matrix for all vectors at once (real and imaginary parts as
+/// `2 k` right-hand sides stored row by row, so every nonzero updates a contiguous row)
+/// instead of `2 k` serial sparse products: the per-mu cost of reduced solves is
+/// dominated by this check, and the backward errors and the condition numbers share the
+/// products with `M` and `C`. The right-hand sides are split between two threads.
+pub(super) fn check_pairs(
+    qep: &QepTerms<'_>,
+    norms: &QepNorms,
+    lambda: &[c64],
+    u: MatRef<'_, c64>,
+    left: Option<MatRef<'_, c64>>,
+    backward: bool,
+) -> (Vec<f64>, Vec<DerivativeProducts>) {
     let (n, k) = (u.nrows(), u.ncols());
-    in_two_halves(k, |lo, hi| {
+    let per_pair = in_two_halves(k, |lo, hi| {
         let w = hi - lo;
         let x = interleave(u, lo, hi);
-        let (mx, kx) = (terms_times(n, &qep.m, &x, w), terms_times(n, &qep.k, &x, w));
+        let mx = terms_times(n, &qep.m, &x, w);
+        let kx = backward.then(|| terms_times(n, &qep.k, &x, w));
         let cx = (!qep.c.is_empty()).then(|| terms_times(n, &qep.c, &x, w));
         let (mut num, mut un) = (vec![0.0; w], vec![0.0; w]);
+        let (mut d, mut ny) = (vec![c64::new(0.0, 0.0); w], vec![0.0; w]);
         for i in 0..n {
             for j in 0..w {
                 let l = lambda[lo + j];
-                let mut t = at(&mx, w, i, j) * l;
-                if let Some(cx) = &cx {
-                    t += at(cx, w, i, j);
+                let m = at(&mx, w, i, j);
+                let c = cx.as_ref().map(|cx| at(cx, w, i, j));
+                if let Some(kx) = &kx {
+                    let mut t = m * l;
+                    if let Some(c) = c {
+                        t += c;
+                    }
+                    num[j] += (t * l + at(kx, w, i, j)).norm_sqr();
                 }
-                num[j] += (t * l + at(&kx, w, i, j)).norm_sqr();
                 un[j] += at(&x, w, i, j).norm_sqr();
+                if let Some(y) = left {
+                    let mut t = m * (l * 2.0);
+                    if let Some(c) = c {
+                        t += c;
+                    }
+                    let yi = y[(i, lo + j)];
+                    d[j] += yi.conj() * t;
+                    ny[j] += yi.norm_sqr();
+                }
             }
         }
         (0..w)
-            .map(|j| norms.relative(lambda[lo + j], num[j].sqrt(), un[j].sqrt()))
+            .map(|j| {
+                let be = norms.relative(lambda[lo + j], num[j].sqrt(), un[j].sqrt());
+                (be, (d[j].norm(), un[j].sqrt(), ny[j].sqrt()))
+            })
             .collect()
-    })
+    });
+    let be = if backward {
+        per_pair.iter().map(|p| p.0).collect()
+    } else {
+        Vec::new()
+    };
+    let products = if left.is_some() {
+        per_pair.into_iter().map(|p| p.1).collect()
+    } else {
+        Vec::new()
+    };
+    (be, products)
 }
 
 /// Columns `[lo, hi)` of `u` as interleaved `(re, im)` rows of width `2 (hi - lo)`.
