@@ -74,6 +74,7 @@ fn build_basis(
             reduced: dense.as_ref(),
             params: &ep,
             stage: None,
+            seed: None,
         },
     )
     .unwrap()

@@ -65,6 +65,7 @@ fn build(reg: &Registry, opts: Params, op: &FrictionalOperator, arpack: &dyn Eig
             reduced: dense.as_ref(),
             params: &ep,
             stage: None,
+            seed: None,
         },
     )
     .unwrap()

@@ -22,6 +22,15 @@
 //!    else add `Re d_j` and `Im d_j` of every unconverged target and re-orthonormalize
 //!    (`M_c`, rank cut of [`squeal_core::reduction`]).
 //!
+//! In a sweep the start also holds the seed of the previous point
+//! ([`BasisRequest::seed`](squeal_core::BasisRequest::seed)): the real and imaginary parts
+//! of its final target modes, carried on the free model's DOFs to this contact set. They
+//! are near this point's target modes, so the first residuals are small and fewer
+//! enrichments reach `tol`; the stopping test is the same, so a seeded basis meets the
+//! same tolerance as one built alone (its columns, and the modes to within that
+//! tolerance, differ). The basis leaves its own target modes as the next seed
+//! ([`Basis::seed`]).
+//!
 //! The error is controlled per mode, but the basis depends on mu and on the contact set
 //! ([`ReductionBasis::depends_on_mu`] is `true`). The basis reports its iterations
 //! (enrichment steps), its final residual `max eps_j`, and a note when it stopped on
@@ -37,11 +46,11 @@
 //! - `rank_tol` (default [`DEFAULT_RANK_TOL`]): relative rank cut of the
 //!   orthonormalization.
 
-use squeal_core::faer::Mat;
+use squeal_core::faer::{Mat, MatRef};
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
-    coupled_real_modes_on, m_orthonormalize, GrowingBasis, PairSolves, StaticSolver,
-    DEFAULT_RANK_TOL, PAIR_SOLVES_STAGE_KEY,
+    coupled_real_modes_on, expand, from_free_dofs, m_orthonormalize, to_free_dofs, GrowingBasis,
+    PairSolves, StaticSolver, DEFAULT_RANK_TOL, PAIR_SOLVES_STAGE_KEY,
 };
 use squeal_core::{
     Basis, BasisRequest, EigenParams, Error, FreeModel, ModelStage, Params, ReductionBasis,
@@ -158,8 +167,17 @@ impl ReductionBasis for ResidueBasis {
         let modes = coupled_real_modes_on(request, cutoff, &ks)?;
         let t_modes = clock.elapsed().as_secs_f64() - t_factor;
         let clock = Instant::now();
-        let (v, mut dropped) = m_orthonormalize(mc, modes.vectors.as_ref(), self.rank_tol)?;
+        // the previous sweep point's target modes, brought to this contact set, join the
+        // start: the residuals then start near where that point ended
+        let seed = request.seed.and_then(|s| from_free_dofs(op, s));
+        let start = match &seed {
+            Some(s) => concat_columns(modes.vectors.as_ref(), s.as_ref()),
+            None => modes.vectors.clone(),
+        };
+        let (v, mut dropped) = m_orthonormalize(mc, start.as_ref(), self.rank_tol)?;
+        drop(start);
         let start_size = v.ncols();
+        let seeded = seed.as_ref().map_or(0, |s| s.ncols());
         let mut v = GrowingBasis::new(op, v)?;
         let targets = EigenParams {
             fmin_hz: fmin * (1.0 - TARGET_MARGIN),
@@ -170,10 +188,13 @@ impl ReductionBasis for ResidueBasis {
         let mut iterations = 0;
         let mut history = Vec::new();
         let mut projected;
+        // the reduced target modes of the last projection: the seed of the next point
+        let mut last;
         let residual = loop {
             let reduced = v.project()?;
             let red = request.reduced.solve_frictional(&reduced, mu, &targets)?;
             projected = reduced;
+            last = red.vectors.clone();
             if red.is_empty() {
                 notes.push(format!(
                     "{NAME}: no target mode in [{:.1}, {:.1}] Hz",
@@ -216,7 +237,22 @@ impl ReductionBasis for ResidueBasis {
                 break residual;
             }
         };
+        // the next point's seed: the last reduced target modes, on the columns they were
+        // solved on
+        let next_seed = Some(last).filter(|q| q.ncols() > 0).and_then(|q| {
+            let u = expand(v.columns(), q.as_ref());
+            let parts = Mat::from_fn(u.nrows(), 2 * u.ncols(), |r, c| {
+                let z = u[(r, c / 2)];
+                if c % 2 == 0 {
+                    z.re
+                } else {
+                    z.im
+                }
+            });
+            to_free_dofs(op, parts.as_ref())
+        });
         let mut basis = Basis::new(v.into_columns());
+        basis.seed = next_seed;
         // every exit of the loop leaves `v` as it was last projected (the stagnation exit
         // kept its columns)
         basis.projected = Some(projected);
@@ -226,11 +262,21 @@ impl ReductionBasis for ResidueBasis {
         notes.insert(
             0,
             format!(
-                "{NAME}: {start_size} real modes up to {cutoff:.1} Hz (`{}`) + {} residual \
+                "{NAME}: {} real modes up to {cutoff:.1} Hz (`{}`){} + {} residual \
                  vectors in {iterations} iterations at mu = {mu}; energy residuals {:?}; \
                  {}; times: set-up {t_factor:.2} s (shared by modes and residuals), modes \
                  {t_modes:.2} s, iterations {:.2} s",
+                modes.vectors.ncols(),
                 request.modal.name(),
+                if seeded > 0 {
+                    format!(
+                        " and {} directions of the previous point's target modes ({seeded} \
+                         given)",
+                        start_size.saturating_sub(modes.vectors.ncols())
+                    )
+                } else {
+                    String::new()
+                },
                 basis.len() - start_size,
                 history
                     .iter()
@@ -243,4 +289,16 @@ impl ReductionBasis for ResidueBasis {
         basis.notes = notes;
         Ok(basis)
     }
+}
+
+/// `[a | b]`.
+fn concat_columns(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
+    let k = a.ncols();
+    Mat::from_fn(a.nrows(), k + b.ncols(), |r, c| {
+        if c < k {
+            a[(r, c)]
+        } else {
+            b[(r, c - k)]
+        }
+    })
 }

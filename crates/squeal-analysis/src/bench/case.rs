@@ -329,6 +329,7 @@ impl Runner<'_> {
             reduced: dense.as_ref(),
             params: &self.params,
             stage,
+            seed: None,
         };
         let b = squeal_core::contact::build_basis(plugin.as_ref(), &req)
             .map_err(core(format!("basis `{basis}` at mu = {mu}")))?;

@@ -179,6 +179,8 @@ pub fn run_sweep(
     )?;
     method.set_condition(s.condition);
     method.share_modal_cache(prep.modal_cache());
+    // consecutive points are near each other: an iterative basis starts from the last
+    method.set_warm_start(true);
     let mut profile = Profile::new();
     // the basis's model stage first: the modes of a synthesis, up to a higher cutoff,
     // serve the tracking too

@@ -91,6 +91,10 @@ pub struct Method {
     stage: Option<ModelStage>,
     condition: bool,
     last: StepTimes,
+    /// Whether a basis starts from the seed its build at the previous point left
+    /// ([`Method::set_warm_start`]).
+    warm_start: bool,
+    seed: Option<squeal_core::faer::Mat<f64>>,
 }
 
 /// Where the time of the last [`Method::solve`] went (s); zero for stages it skipped.
@@ -146,7 +150,21 @@ impl Method {
             stage: None,
             condition: false,
             last: StepTimes::default(),
+            warm_start: false,
+            seed: None,
         })
+    }
+
+    /// Hands each basis the seed the basis built at the previous call left
+    /// ([`squeal_core::Basis::seed`]; the residue method starts from the previous point's
+    /// target modes): for a sweep, whose consecutive points are near each other. Off by
+    /// default, so that a study's cases, solved in any order by any worker, do not
+    /// depend on which case came before.
+    pub fn set_warm_start(&mut self, on: bool) {
+        self.warm_start = on;
+        if !on {
+            self.seed = None;
+        }
     }
 
     /// Whether full-order modes always get condition numbers and forward error
@@ -259,9 +277,14 @@ impl Method {
                 reduced: self.eigen.as_ref(),
                 params: &self.params,
                 stage: self.stage.as_deref(),
+                seed: self.seed.as_ref().map(|s| s.as_ref()),
             };
-            let b = squeal_core::contact::build_basis(basis.as_ref(), &req)
+            let mut b = squeal_core::contact::build_basis(basis.as_ref(), &req)
                 .map_err(core(&format!("basis `{}` at mu = {mu}", self.basis_name)))?;
+            let seed = b.seed.take();
+            if self.warm_start {
+                self.seed = seed;
+            }
             self.cached = Some(
                 squeal_core::reduction::ReducedOperator::new(op, b)
                     .map_err(core("projection on the basis"))?,

@@ -49,6 +49,11 @@ pub struct Basis {
     /// building (an iterative basis projects at every step): the projection stage takes
     /// it instead of projecting again. `None`: projected after the build.
     pub projected: Option<FrictionalOperator>,
+    /// Directions a basis of the same method at the next point of a sweep may start from
+    /// ([`BasisRequest::seed`]), on the free model's DOFs (the numbering of the operator's
+    /// index map `T`; [`crate::reduction::to_free_dofs`]): the residue method leaves the
+    /// real and imaginary parts of its target modes. `None`: nothing to hand on.
+    pub seed: Option<Mat<f64>>,
 }
 
 impl Basis {
@@ -64,6 +69,7 @@ impl Basis {
             residual: None,
             notes: Vec::new(),
             projected: None,
+            seed: None,
         }
     }
 
@@ -119,6 +125,11 @@ pub struct BasisRequest<'a> {
     /// the caller for a basis that has one ([`ReductionBasis::stage_key`]); `None`
     /// otherwise, or when the operator comes without its model (read from files).
     pub stage: Option<&'a (dyn Any + Send + Sync)>,
+    /// The seed the basis built at the previous point of a sweep left ([`Basis::seed`],
+    /// on the free model's DOFs), which a basis may add to its start: it changes where an
+    /// iterative basis starts, not what it has to reach (its own tolerance). `None`
+    /// outside sweeps and at a sweep's first point.
+    pub seed: Option<MatRef<'a, f64>>,
 }
 
 /// Builds a reduction basis for one frictional operator.

@@ -51,6 +51,7 @@ mod growing;
 mod mac;
 mod orthonormal;
 mod project;
+mod seed;
 mod solve;
 mod statics;
 #[cfg(test)]
@@ -66,6 +67,7 @@ pub use orthonormal::{
     m_svd_compress, DEFAULT_RANK_TOL,
 };
 pub use project::{dense_to_sparse, project};
+pub use seed::{from_free_dofs, to_free_dofs};
 pub use solve::{solve_reduced, ReducedOperator, ReducedSolve};
 pub use statics::{energy_residuals, StaticSolver};
 pub use tied::{PairSolves, TiedSolve, PAIR_SOLVES_LIMIT_BYTES, PAIR_SOLVES_STAGE_KEY};

@@ -378,6 +378,7 @@ fn backward_error_flags_a_perturbed_mode_and_a_truncated_basis() {
         reduced: &Dense,
         params: &wide_band(),
         stage: None,
+        seed: None,
     };
     let rm = coupled_real_modes(&req, 1e6).unwrap();
     let v8 = rm.vectors.as_ref().subcols(0, 8).to_owned();
@@ -781,4 +782,43 @@ fn carried_images_stay_exact_when_a_block_pass_leaves_columns_short() {
         }
     }
     assert!(worst < 1e-11, "carried image off by {worst:e}");
+}
+
+#[test]
+fn directions_travel_between_contact_sets_on_the_free_dofs() {
+    let (_, pairs, from, _) = tied_model(&[0, 2]);
+    let (_, _, to, _) = tied_model(&[2, 3]);
+    let mut rng = Rng(7);
+    let v = Mat::from_fn(from.dim(), 3, |_, _| rng.next());
+    let w = to_free_dofs(&from, v.as_ref()).unwrap();
+    let t = from.t.as_ref().unwrap();
+    assert_eq!(w.nrows(), t.len());
+    // both DOFs of a tie carry the constrained value
+    for &i in &[0, 2] {
+        let (p, d) = (pairs[i].pin[2], pairs[i].disc[2]);
+        assert_eq!(t[p], t[d]);
+        for c in 0..3 {
+            assert_eq!(w[(p, c)], w[(d, c)]);
+        }
+    }
+    // back onto the same contact set: the columns themselves
+    let back = from_free_dofs(&from, w.as_ref()).unwrap();
+    assert_eq!(back, v);
+    // onto another one: a new tie takes the mean of its two DOFs, the rest their value
+    let moved = from_free_dofs(&to, w.as_ref()).unwrap();
+    let tt = to.t.as_ref().unwrap();
+    assert_eq!(moved.nrows(), to.dim());
+    let (p, d) = (pairs[3].pin[2], pairs[3].disc[2]);
+    for c in 0..3 {
+        let mean = 0.5 * (w[(p, c)] + w[(d, c)]);
+        assert!((moved[(tt[p], c)] - mean).abs() <= 1e-15 * mean.abs().max(1.0));
+        let (p0, d0) = (pairs[0].pin[2], pairs[0].disc[2]);
+        assert_eq!(moved[(tt[p0], c)], w[(p0, c)]);
+        assert_eq!(moved[(tt[d0], c)], w[(d0, c)]);
+    }
+    // an operator without its index map, or columns of the wrong length: nothing
+    let mut bare = from.clone();
+    bare.t = None;
+    assert!(to_free_dofs(&bare, v.as_ref()).is_none());
+    assert!(from_free_dofs(&from, v.as_ref()).is_none());
 }
