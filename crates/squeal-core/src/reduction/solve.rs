@@ -47,6 +47,8 @@ impl ReducedOperator {
     /// Projects `op` on `basis` (or takes the projection the basis carries).
     pub fn new(op: &FrictionalOperator, mut basis: Basis) -> Result<Self> {
         let start = Instant::now();
+        // a sweep's driver takes the seed for the next point before; nothing here uses it
+        basis.seed = None;
         let m = basis.len();
         let reduced = match basis.projected.take() {
             Some(p) if p.dim() == m => p,
