@@ -12,11 +12,11 @@
 //!   sizes, times, errors and speed-ups.
 
 use squeal::analysis::pipeline::{run_mu_sweep, Method, Prepared};
-use squeal::core::faer::{Mat, Side};
+use squeal::core::faer::{Mat, MatRef, Side};
 use squeal::core::operator::ComplexModes;
 use squeal::core::reduction::{
-    friction_load_directions, m_orthonormality_error, m_orthonormalize, solve_reduced,
-    sparse_times, StaticSolver, DEFAULT_RANK_TOL,
+    friction_load_directions, from_free_dofs, m_orthonormality_error, m_orthonormalize,
+    real_modes_seed, solve_reduced, sparse_times, StaticSolver, DEFAULT_RANK_TOL,
 };
 use squeal::core::spectral::SpectralTransform;
 use squeal::core::{
@@ -434,7 +434,7 @@ fn real_modes_on_the_static_solvers_factor_match_a_fresh_solve() {
         let si = statics.shift_invert(op.mc.as_ref()).unwrap();
         assert_eq!(si.shift(), -shift);
         let shared = arpack
-            .solve_symmetric_on(&problem, &si, &params(3750.0))
+            .solve_symmetric_on(&problem, &si, None, &params(3750.0))
             .unwrap();
         println!(
             "shift {shift_hz} Hz: {} modes ({} fresh), {} factorizations, highest {:.3} Hz",
@@ -461,6 +461,61 @@ fn real_modes_on_the_static_solvers_factor_match_a_fresh_solve() {
     let free = prep.operator(&one).unwrap();
     assert!(free.dim() > op.dim());
     assert!(statics.shift_invert(free.mc.as_ref()).is_err());
+}
+
+/// The real modes of a contact set started from another contact set's (carried on the
+/// free model's DOFs, as a sweep's bases hand them on) are the same modes to the
+/// tolerance, from fewer applications of the shift-invert operator than a fresh start.
+#[test]
+fn real_modes_started_from_another_contact_sets_need_fewer_solves() {
+    let reg = squeal::registry();
+    let prep = Prepared::new(&reg, coarse(), "coarse").unwrap();
+    let krylov = solver(&reg, "krylov");
+    let ops: Vec<FrictionalOperator> = [0.3, 0.6]
+        .iter()
+        .map(|&mu| {
+            let eq = prep.equilibrium(&reg, "lcp", "lagrange", mu).unwrap();
+            prep.operator(&eq.eq.active).unwrap()
+        })
+        .collect();
+    assert_ne!(ops[0].dim(), ops[1].dim(), "two contact sets");
+    let solve = |op: &FrictionalOperator, start: Option<MatRef<'_, f64>>| {
+        let problem = SymmetricProblem {
+            k: op.kc.as_ref(),
+            m: op.mc.as_ref(),
+        };
+        let statics = StaticSolver::new(op, 0.0).unwrap();
+        let si = statics.shift_invert(op.mc.as_ref()).unwrap();
+        krylov
+            .solve_symmetric_on(&problem, &si, start, &params(3750.0))
+            .unwrap()
+    };
+    let first = solve(&ops[0], None);
+    let seed = real_modes_seed(&ops[0], &first).expect("an operator with its index map");
+    assert_eq!(seed.nrows(), ops[0].t.as_ref().unwrap().len());
+    assert_eq!(
+        seed.ncols(),
+        first.freq_hz.len() + first.above_band.ncols(),
+        "the band's modes and the pairs found above it"
+    );
+    let start = from_free_dofs(&ops[1], seed.as_ref()).unwrap();
+    let fresh = solve(&ops[1], None);
+    let started = solve(&ops[1], Some(start.as_ref()));
+    println!(
+        "{} modes: fresh {} applications, {} restarts; started {} applications, {} restarts",
+        fresh.freq_hz.len(),
+        fresh.info.op_applications,
+        fresh.info.iterations,
+        started.info.op_applications,
+        started.info.iterations
+    );
+    assert!(started.info.notes.iter().any(|n| n.contains("nearby")));
+    assert_eq!(started.freq_hz.len(), fresh.freq_hz.len());
+    for (a, b) in started.freq_hz.iter().zip(&fresh.freq_hz) {
+        assert!((a - b).abs() <= 1e-9 * b, "{a} Hz against {b} Hz");
+    }
+    assert!(started.residuals.iter().all(|&r| r < 1e-10));
+    assert!(started.info.op_applications < fresh.info.op_applications);
 }
 
 // ------------------------------------------------------------------------------------

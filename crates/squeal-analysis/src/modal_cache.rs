@@ -15,6 +15,7 @@
 //! beyond that. Complex (frictional) solves are passed through unchanged.
 
 use squeal_core::eigen::SymmetricProblem;
+use squeal_core::faer::MatRef;
 use squeal_core::operator::RealModes;
 use squeal_core::operator::{ComplexModes, Qep};
 use squeal_core::spectral::ShiftInvert;
@@ -207,15 +208,17 @@ impl EigenSolver for CachedModal {
     }
 
     /// Served from the cache like [`solve_symmetric`](Self::solve_symmetric) (the modes of
-    /// one band do not depend on the shift that found them); a miss solves on `op`.
+    /// one band do not depend on the shift that found them, nor on where the iteration
+    /// started: both meet the same tolerance); a miss solves on `op` from `start`.
     fn solve_symmetric_on(
         &self,
         problem: &SymmetricProblem<'_>,
         op: &ShiftInvert<'_>,
+        start: Option<MatRef<'_, f64>>,
         params: &EigenParams,
     ) -> Result<RealModes> {
         self.cached(problem, params, || {
-            self.inner.solve_symmetric_on(problem, op, params)
+            self.inner.solve_symmetric_on(problem, op, start, params)
         })
     }
 
@@ -274,6 +277,7 @@ mod tests {
                 vectors: Mat::from_fn(n, k, |i, j| if i == j { 1.0 } else { 0.0 }),
                 residuals: vec![0.0; k],
                 info: SolveInfo::new("counting"),
+                above_band: Mat::zeros(n, 0),
             })
         }
     }
@@ -314,7 +318,9 @@ mod tests {
         assert!(again.info.notes.iter().any(|n| n.contains("reused")));
         // on a caller's factorization: the same band, so served from the cache too
         let si = ShiftInvert::new(k.as_ref(), m.as_ref(), 0.0).unwrap();
-        let on = solver.solve_symmetric_on(&p, &si, &params(2)).unwrap();
+        let on = solver
+            .solve_symmetric_on(&p, &si, None, &params(2))
+            .unwrap();
         assert_eq!((calls.load(Ordering::SeqCst), cache.hits()), (1, 2));
         assert_eq!(on.omega2, first.omega2);
 

@@ -41,7 +41,7 @@ pub mod spectral;
 
 pub use contact::{
     build_basis, Basis, BasisRequest, ContactLaw, EquilibriumSolver, FreeModel, ImplicitColumns,
-    ModelStage, PairDofs, ReductionBasis,
+    ModelStage, PairDofs, ReductionBasis, Seed,
 };
 pub use eigen::{
     solve_symmetric_band, solve_symmetric_band_on, EigenParams, EigenSolver, KernelOutput,

@@ -19,7 +19,8 @@
 //!
 //! Fixed in mu, not in contact set: built once per contact set (a new active set means
 //! a new `T` and a new basis) and reused across a whole mu sweep
-//! ([`ReductionBasis::depends_on_mu`] is `false`).
+//! ([`ReductionBasis::depends_on_mu`] is `false`). In a sweep the real modes of a new
+//! contact set start from the previous set's ([`Basis::seed`]), which are near them.
 //!
 //! ## Parameters
 //!
@@ -32,8 +33,8 @@
 use squeal_core::linalg::norm2;
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
-    coupled_real_modes_on, m_orthonormal_extend, m_orthonormalize, m_svd_compress, PairSolves,
-    StaticSolver, DEFAULT_RANK_TOL, PAIR_SOLVES_STAGE_KEY,
+    coupled_real_modes_on, m_orthonormal_extend, m_orthonormalize, m_svd_compress, real_modes_cost,
+    real_modes_seed, PairSolves, StaticSolver, DEFAULT_RANK_TOL, PAIR_SOLVES_STAGE_KEY,
 };
 use squeal_core::{
     Basis, BasisRequest, Error, FreeModel, ModelStage, Params, ReductionBasis, Registry, Result,
@@ -153,11 +154,12 @@ impl ReductionBasis for EnrichedBasis {
             m_orthonormal_extend(mc, vm.as_ref(), statics.as_ref(), self.rank_tol)?;
         let t_orth = clock.elapsed().as_secs_f64();
         let mut basis = Basis::new(v);
+        basis.seed.real_modes = real_modes_seed(op, &modes);
         basis.dropped = dropped_modes + dropped_svd + dropped_static;
         basis.notes.push(format!(
             "{NAME}: {} real modes up to {cutoff:.1} Hz (`{}`) + {} static vectors of {loads} \
              friction loads ({} removed by the SVD cut{}, {} by the rank cut); {}; times: set-up \
-             {t_factor:.2} s (shared by modes and statics), modes {t_modes:.2} s, static \
+             {t_factor:.2} s (shared by modes and statics), modes {t_modes:.2} s ({}), static \
              responses {t_statics:.2} s{}, orthonormalization {t_orth:.2} s",
             vm.ncols(),
             request.modal.name(),
@@ -166,6 +168,7 @@ impl ReductionBasis for EnrichedBasis {
             self.svd_tol.map_or(String::new(), |t| format!(" at {t:e}")),
             dropped_static,
             method,
+            real_modes_cost(&modes),
             if kept_responses {
                 " (corrected onto the ties from the free model's kept responses to the \
                  pairs' friction loads)"

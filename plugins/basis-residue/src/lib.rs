@@ -29,7 +29,8 @@
 //! enrichments reach `tol`; the stopping test is the same, so a seeded basis meets the
 //! same tolerance as one built alone (its columns, and the modes to within that
 //! tolerance, differ). The basis leaves its own target modes as the next seed
-//! ([`Basis::seed`]).
+//! ([`Basis::seed`]), with its real modes, from which the next contact set's real modes
+//! start ([`squeal_core::reduction::coupled_real_modes_on`]).
 //!
 //! The error is controlled per mode, but the basis depends on mu and on the contact set
 //! ([`ReductionBasis::depends_on_mu`] is `true`). The basis reports its iterations
@@ -49,8 +50,9 @@
 use squeal_core::faer::{Mat, MatRef};
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
-    coupled_real_modes_on, expand, from_free_dofs, m_orthonormalize, to_free_dofs, GrowingBasis,
-    PairSolves, StaticSolver, DEFAULT_RANK_TOL, PAIR_SOLVES_STAGE_KEY,
+    coupled_real_modes_on, expand, from_free_dofs, m_orthonormalize, real_modes_cost,
+    real_modes_seed, to_free_dofs, GrowingBasis, PairSolves, StaticSolver, DEFAULT_RANK_TOL,
+    PAIR_SOLVES_STAGE_KEY,
 };
 use squeal_core::{
     Basis, BasisRequest, EigenParams, Error, FreeModel, ModelStage, Params, ReductionBasis,
@@ -169,7 +171,10 @@ impl ReductionBasis for ResidueBasis {
         let clock = Instant::now();
         // the previous sweep point's target modes, brought to this contact set, join the
         // start: the residuals then start near where that point ended
-        let seed = request.seed.and_then(|s| from_free_dofs(op, s));
+        let seed = request
+            .seed
+            .and_then(|s| s.directions.as_ref())
+            .and_then(|s| from_free_dofs(op, s.as_ref()));
         let start = match &seed {
             Some(s) => concat_columns(modes.vectors.as_ref(), s.as_ref()),
             None => modes.vectors.clone(),
@@ -252,7 +257,8 @@ impl ReductionBasis for ResidueBasis {
             to_free_dofs(op, parts.as_ref())
         });
         let mut basis = Basis::new(v.into_columns());
-        basis.seed = next_seed;
+        basis.seed.directions = next_seed;
+        basis.seed.real_modes = real_modes_seed(op, &modes);
         // every exit of the loop leaves `v` as it was last projected (the stagnation exit
         // kept its columns)
         basis.projected = Some(projected);
@@ -265,7 +271,7 @@ impl ReductionBasis for ResidueBasis {
                 "{NAME}: {} real modes up to {cutoff:.1} Hz (`{}`){} + {} residual \
                  vectors in {iterations} iterations at mu = {mu}; energy residuals {:?}; \
                  {}; times: set-up {t_factor:.2} s (shared by modes and residuals), modes \
-                 {t_modes:.2} s, iterations {:.2} s",
+                 {t_modes:.2} s ({}), iterations {:.2} s",
                 modes.vectors.ncols(),
                 request.modal.name(),
                 if seeded > 0 {
@@ -283,6 +289,7 @@ impl ReductionBasis for ResidueBasis {
                     .map(|r| format!("{r:.2e}"))
                     .collect::<Vec<_>>(),
                 ks.method,
+                real_modes_cost(&modes),
                 clock.elapsed().as_secs_f64()
             ),
         );

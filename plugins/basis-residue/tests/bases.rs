@@ -360,32 +360,38 @@ fn residue_seeded_by_the_previous_point_needs_fewer_enrichments() {
     let dense = reg.eigen.create("dense", &Params::new()).unwrap();
     let residue = reg.bases.create("residue", &Params::new()).unwrap();
     let ep = params(FMAX);
-    let build =
-        |op: &FrictionalOperator, mu: f64, seed: Option<squeal_core::faer::MatRef<'_, f64>>| {
-            squeal_core::build_basis(
-                residue.as_ref(),
-                &BasisRequest {
-                    op,
-                    mu,
-                    band_hz: (0.0, FMAX),
-                    modal: arpack.as_ref(),
-                    reduced: dense.as_ref(),
-                    params: &ep,
-                    stage: None,
-                    seed,
-                },
-            )
-            .unwrap()
-        };
+    let build = |op: &FrictionalOperator, mu: f64, seed: Option<&squeal_core::Seed>| {
+        squeal_core::build_basis(
+            residue.as_ref(),
+            &BasisRequest {
+                op,
+                mu,
+                band_hz: (0.0, FMAX),
+                modal: arpack.as_ref(),
+                reduced: dense.as_ref(),
+                params: &ep,
+                stage: None,
+                seed,
+            },
+        )
+        .unwrap()
+    };
     let (mu0, mu1) = (0.6, 0.7);
     let eq0 = prep.equilibrium(&reg, "lcp", "lagrange", mu0).unwrap();
     let op0 = prep.operator(&eq0.eq.active).unwrap();
     let first = build(&op0, mu0, None);
-    let seed = first
-        .seed
-        .clone()
-        .expect("a converged residue basis leaves a seed");
-    assert_eq!(seed.nrows(), op0.t.as_ref().unwrap().len());
+    let seed = first.seed.clone();
+    let free_dofs = op0.t.as_ref().unwrap().len();
+    let directions = seed
+        .directions
+        .as_ref()
+        .expect("a converged residue basis leaves its target modes");
+    assert_eq!(directions.nrows(), free_dofs);
+    let modes = seed
+        .real_modes
+        .as_ref()
+        .expect("a residue basis leaves its real modes");
+    assert_eq!(modes.nrows(), free_dofs);
     let eq1 = prep.equilibrium(&reg, "lcp", "lagrange", mu1).unwrap();
     let op1 = prep.operator(&eq1.eq.active).unwrap();
     println!(
@@ -395,7 +401,7 @@ fn residue_seeded_by_the_previous_point_needs_fewer_enrichments() {
         op1.dim()
     );
     let alone = build(&op1, mu1, None);
-    let seeded = build(&op1, mu1, Some(seed.as_ref()));
+    let seeded = build(&op1, mu1, Some(&seed));
     println!(
         "alone: {} columns, {} enrichments, residual {:.2e}; seeded: {} columns, {} \
          enrichments, residual {:.2e}",

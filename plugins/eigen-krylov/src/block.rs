@@ -46,7 +46,9 @@
 //!   tolerance (or at rounding level) add no direction: in a multiple eigenvalue their
 //!   noise would bring in unconverged copies.
 //!
-//! Start block: deterministic pseudo-random columns, so results are reproducible.
+//! Start block: deterministic pseudo-random columns, so results are reproducible, or the
+//! columns of a given start (approximate wanted vectors of a nearby problem) completed by
+//! such columns.
 
 use super::{par_for, Directions, BREAKDOWN};
 use squeal_core::eigen::{dense_symmetric_pencil, KernelOutput};
@@ -433,6 +435,7 @@ pub(crate) fn largest_block(
     tol: f64,
     max_restarts: usize,
     block: usize,
+    start: Option<MatRef<'_, f64>>,
 ) -> Result<BlockOutcome> {
     let n = op.dim();
     let nev = nev.min(n);
@@ -452,9 +455,16 @@ pub(crate) fn largest_block(
         m: 0,
         dirs: Directions::new(),
     };
+    // the given start's columns (at most b), then pseudo-random ones
+    let given = start.map_or(0, |g| g.ncols().min(b));
     let start = {
         let mut cols = Mat::<f64>::zeros(n, b);
-        for j in 0..b {
+        if let Some(g) = start {
+            cols.as_mut()
+                .subcols_mut(0, given)
+                .copy_from(g.subcols(0, given));
+        }
+        for j in given..b {
             let d = s.dirs.vector(n);
             cols.col_mut(j)
                 .iter_mut()

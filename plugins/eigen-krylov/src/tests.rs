@@ -3,7 +3,7 @@
 use super::*;
 use squeal_core::eigen::dense_symmetric;
 use squeal_core::faer::sparse::Triplet;
-use squeal_core::faer::Mat;
+use squeal_core::faer::{Mat, MatRef};
 use squeal_core::spectral::SpectralTransform;
 use squeal_core::{EigenParams, EigenSolver, RealModes, SymmetricProblem};
 use squeal_core::{SparseMat, StopReason};
@@ -696,4 +696,82 @@ fn calls_above_the_block_pair_cap_take_the_single_vector_kernel() {
     assert_ne!(at.theta, at_single.theta);
     let lam: Vec<f64> = at.theta.iter().map(|&t| op.pencil_eigenvalue(t)).collect();
     assert_true_eigenvalues(&lam, &exact, 1e-9);
+}
+
+/// The modes of a nearby problem (one chain's springs stiffened by 10 % over a stretch,
+/// as a contact set that ties a few more pairs) as the start: the same modes to the
+/// tolerance, from fewer applications of `OP` than the pseudo-random start.
+#[test]
+fn a_nearby_problems_modes_start_the_band_with_fewer_applications() {
+    let half = 400;
+    let (k0, m) = twin_chains(half);
+    let spring = |s: usize| {
+        let stiffer = if (100..140).contains(&s) { 1.1 } else { 1.0 };
+        K * (1.0 + 0.3 * (s as f64).sin()) * stiffer
+    };
+    let mut kt = Vec::new();
+    chain_k(&mut kt, 0, half, spring, true);
+    chain_k(
+        &mut kt,
+        half,
+        half,
+        |s| K * (1.0 + 0.3 * (s as f64).sin()),
+        true,
+    );
+    let k1 = sparse(2 * half, &kt);
+    fn p<'a>(k: &'a SparseMat, m: &'a SparseMat) -> SymmetricProblem<'a> {
+        SymmetricProblem {
+            k: k.as_ref(),
+            m: m.as_ref(),
+        }
+    }
+    let (mut exact, _) = dense_symmetric(&p(&k1, &m)).unwrap();
+    exact.sort_by(f64::total_cmp);
+    let count = 40;
+    let fmax = 0.5 * (hz(exact[count - 1]) + hz(exact[count]));
+    let params = params(fmax);
+    let before = KRYLOV.solve_symmetric(&p(&k0, &m), &params).unwrap();
+    assert!(before.omega2.len() >= count - 2);
+    let sigma = -0.1 * exact[0];
+    let solve = |start: Option<MatRef<'_, f64>>| {
+        let op = ShiftInvert::new(k1.as_ref(), m.as_ref(), sigma).unwrap();
+        KRYLOV
+            .solve_symmetric_on(&p(&k1, &m), &op, start, &params)
+            .unwrap()
+    };
+    let fresh = solve(None);
+    // the band's modes and the pairs above it the solve found
+    let (band, above) = (&before.vectors, &before.above_band);
+    assert!(above.ncols() > 0 && above.ncols() <= squeal_core::eigen::ABOVE_BAND_KEPT);
+    let start = Mat::from_fn(band.nrows(), band.ncols() + above.ncols(), |r, c| {
+        if c < band.ncols() {
+            band[(r, c)]
+        } else {
+            above[(r, c - band.ncols())]
+        }
+    });
+    let started = solve(Some(start.as_ref()));
+    eprintln!(
+        "fresh: {} applications, {} restarts; from the nearby modes ({}): {} applications, {} \
+         restarts, notes {:?}",
+        fresh.info.op_applications,
+        fresh.info.iterations,
+        before.omega2.len(),
+        started.info.op_applications,
+        started.info.iterations,
+        started.info.notes
+    );
+    for modes in [&fresh, &started] {
+        assert_eq!(modes.omega2.len(), count);
+        assert!(max_rel_err(&modes.omega2, &exact[..count]) < 1e-10);
+        assert_residuals(modes);
+        assert_m_orthonormal(&modes.vectors, &m, 1e-9);
+    }
+    assert!(started.info.notes.iter().any(|n| n.contains("nearby")));
+    assert!(
+        started.info.op_applications < fresh.info.op_applications,
+        "{} >= {}",
+        started.info.op_applications,
+        fresh.info.op_applications
+    );
 }

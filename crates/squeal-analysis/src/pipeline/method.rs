@@ -94,7 +94,7 @@ pub struct Method {
     /// Whether a basis starts from the seed its build at the previous point left
     /// ([`Method::set_warm_start`]).
     warm_start: bool,
-    seed: Option<squeal_core::faer::Mat<f64>>,
+    seed: squeal_core::Seed,
 }
 
 /// Where the time of the last [`Method::solve`] went (s); zero for stages it skipped.
@@ -151,19 +151,20 @@ impl Method {
             condition: false,
             last: StepTimes::default(),
             warm_start: false,
-            seed: None,
+            seed: squeal_core::Seed::default(),
         })
     }
 
     /// Hands each basis the seed the basis built at the previous call left
-    /// ([`squeal_core::Basis::seed`]; the residue method starts from the previous point's
+    /// ([`squeal_core::Basis::seed`]: the real modes of a basis that computes them start
+    /// from the previous contact set's, the residue method also from the previous point's
     /// target modes): for a sweep, whose consecutive points are near each other. Off by
     /// default, so that a study's cases, solved in any order by any worker, do not
     /// depend on which case came before.
     pub fn set_warm_start(&mut self, on: bool) {
         self.warm_start = on;
         if !on {
-            self.seed = None;
+            self.seed = squeal_core::Seed::default();
         }
     }
 
@@ -277,11 +278,11 @@ impl Method {
                 reduced: self.eigen.as_ref(),
                 params: &self.params,
                 stage: self.stage.as_deref(),
-                seed: self.seed.as_ref().map(|s| s.as_ref()),
+                seed: Some(&self.seed).filter(|s| !s.is_empty()),
             };
             let mut b = squeal_core::contact::build_basis(basis.as_ref(), &req)
                 .map_err(core(&format!("basis `{}` at mu = {mu}", self.basis_name)))?;
-            let seed = b.seed.take();
+            let seed = std::mem::take(&mut b.seed);
             if self.warm_start {
                 self.seed = seed;
             }

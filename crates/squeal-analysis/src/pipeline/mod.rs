@@ -115,6 +115,7 @@ fn modes_below(modes: &RealModes, fmax_hz: f64) -> RealModes {
         vectors: modes.vectors.as_ref().subcols(0, k).to_owned(),
         residuals: modes.residuals[..k].to_vec(),
         info: modes.info.clone(),
+        above_band: squeal_core::faer::Mat::zeros(modes.vectors.nrows(), 0),
     }
 }
 

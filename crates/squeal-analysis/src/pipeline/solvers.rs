@@ -2,6 +2,7 @@
 //! backend for the real-mode problems, another for the full-order complex ones.
 
 use squeal_core::eigen::SymmetricProblem;
+use squeal_core::faer::MatRef;
 use squeal_core::operator::{ComplexModes, Qep, RealModes};
 use squeal_core::spectral::ShiftInvert;
 use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Params, Registry, Result};
@@ -53,9 +54,10 @@ impl EigenSolver for ModalSolvers {
         &self,
         problem: &SymmetricProblem<'_>,
         op: &ShiftInvert<'_>,
+        start: Option<MatRef<'_, f64>>,
         params: &EigenParams,
     ) -> Result<RealModes> {
-        self.real.solve_symmetric_on(problem, op, params)
+        self.real.solve_symmetric_on(problem, op, start, params)
     }
 
     fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {
@@ -135,7 +137,7 @@ mod tests {
         assert!(real.contains("lanczos: real"), "{real}");
         let op = ShiftInvert::new(eye.as_ref(), eye.as_ref(), -1.0).unwrap();
         let on = split
-            .solve_symmetric_on(&problem, &op, &p)
+            .solve_symmetric_on(&problem, &op, None, &p)
             .unwrap_err()
             .to_string();
         assert!(on.contains("lanczos: real"), "{on}");

@@ -49,11 +49,33 @@ pub struct Basis {
     /// building (an iterative basis projects at every step): the projection stage takes
     /// it instead of projecting again. `None`: projected after the build.
     pub projected: Option<FrictionalOperator>,
-    /// Directions a basis of the same method at the next point of a sweep may start from
-    /// ([`BasisRequest::seed`]), on the free model's DOFs (the numbering of the operator's
-    /// index map `T`; [`crate::reduction::to_free_dofs`]): the residue method leaves the
-    /// real and imaginary parts of its target modes. `None`: nothing to hand on.
-    pub seed: Option<Mat<f64>>,
+    /// What a basis of the same method at the next point of a sweep may start from
+    /// ([`BasisRequest::seed`]); empty when there is nothing to hand on.
+    pub seed: Seed,
+}
+
+/// What a basis hands to the basis of the same method at the next point of a sweep
+/// ([`Basis::seed`], [`BasisRequest::seed`]). Every matrix is on the free model's DOFs
+/// (the numbering of the operator's index map `T`, [`crate::reduction::to_free_dofs`]),
+/// since each contact set has its own constrained space. A seed changes where an
+/// iteration starts, never what it has to reach: results agree with an unseeded build
+/// to the tolerances asked.
+#[derive(Debug, Clone, Default)]
+pub struct Seed {
+    /// The contact set's real modes of `(K_c, M_c)` the basis computed: the next contact
+    /// set's real modes start their iteration from them
+    /// ([`crate::reduction::coupled_real_modes_on`]).
+    pub real_modes: Option<Mat<f64>>,
+    /// Further directions the method adds to its own start (the residue method: the real
+    /// and imaginary parts of its target modes).
+    pub directions: Option<Mat<f64>>,
+}
+
+impl Seed {
+    /// Whether the seed holds nothing.
+    pub fn is_empty(&self) -> bool {
+        self.real_modes.is_none() && self.directions.is_none()
+    }
 }
 
 impl Basis {
@@ -69,7 +91,7 @@ impl Basis {
             residual: None,
             notes: Vec::new(),
             projected: None,
-            seed: None,
+            seed: Seed::default(),
         }
     }
 
@@ -125,11 +147,11 @@ pub struct BasisRequest<'a> {
     /// the caller for a basis that has one ([`ReductionBasis::stage_key`]); `None`
     /// otherwise, or when the operator comes without its model (read from files).
     pub stage: Option<&'a (dyn Any + Send + Sync)>,
-    /// The seed the basis built at the previous point of a sweep left ([`Basis::seed`],
-    /// on the free model's DOFs), which a basis may add to its start: it changes where an
-    /// iterative basis starts, not what it has to reach (its own tolerance). `None`
-    /// outside sweeps and at a sweep's first point.
-    pub seed: Option<MatRef<'a, f64>>,
+    /// The seed the basis built at the previous point of a sweep left ([`Basis::seed`]),
+    /// which a basis may start from: it changes where an iteration starts, not what it
+    /// has to reach (its own tolerance). `None` outside sweeps and at a sweep's first
+    /// point.
+    pub seed: Option<&'a Seed>,
 }
 
 /// Builds a reduction basis for one frictional operator.

@@ -14,7 +14,7 @@ mod law;
 mod lcp;
 mod stage;
 
-pub use basis::{build_basis, Basis, BasisRequest, ImplicitColumns, ReductionBasis};
+pub use basis::{build_basis, Basis, BasisRequest, ImplicitColumns, ReductionBasis, Seed};
 pub use condensation::{add_transpose_times, Condensation};
 pub use equilibrium::{check_mu, ContactProblem, Equilibrium, EquilibriumSolver};
 pub use law::ContactLaw;

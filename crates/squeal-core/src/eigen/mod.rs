@@ -18,5 +18,5 @@ pub use params::{too_many_modes, validate_params, EigenParams};
 pub use solver::EigenSolver;
 pub use symmetric::{
     dense_symmetric, dense_symmetric_pencil, finish_real_modes, solve_symmetric_band,
-    solve_symmetric_band_on, KernelOutput, SymmetricKernel, SymmetricProblem,
+    solve_symmetric_band_on, KernelOutput, SymmetricKernel, SymmetricProblem, ABOVE_BAND_KEPT,
 };

@@ -43,6 +43,21 @@ pub trait SymmetricKernel: Send + Sync {
         tol: f64,
         max_restarts: usize,
     ) -> Result<KernelOutput>;
+
+    /// [`largest`](Self::largest) started from `start`: columns approximating the wanted
+    /// eigenvectors (a nearby problem's, the largest `theta` first). The pairs must meet
+    /// `tol` as from any start. The default ignores `start`.
+    fn largest_from(
+        &self,
+        op: &ShiftInvert<'_>,
+        start: MatRef<'_, f64>,
+        nev: usize,
+        tol: f64,
+        max_restarts: usize,
+    ) -> Result<KernelOutput> {
+        let _ = start;
+        self.largest(op, nev, tol, max_restarts)
+    }
 }
 
 /// Band driver shared by all symmetric backends: shift-invert below the spectrum,
@@ -63,16 +78,22 @@ pub fn solve_symmetric_band(
     let shift_hz = params.shift_hz.unwrap_or(params.fmax_hz / 20.0).abs();
     let sigma = -(two_pi * shift_hz).powi(2);
     let op = ShiftInvert::new(problem.k, problem.m, sigma)?;
-    band(solver, kernel, problem, &op, params, 1, start)
+    band(solver, kernel, problem, &op, None, params, 1, start)
 }
 
 /// [`solve_symmetric_band`] on a shift-invert operator the caller factorized (its shift
 /// replaces `params.shift_hz`; it must lie below the spectrum): no factorization here.
+/// `start` (approximate modes, ascending frequency, best with the pairs above the band
+/// a nearby solve found: [`RealModes::above_band`]; [`SymmetricKernel::largest_from`])
+/// is where the kernel starts; the first call asks for as many pairs as it has columns
+/// (or `params.nev_hint` when that is more), so that no wanted pair starts from nothing,
+/// and grows like any other when they all lie below the band top.
 pub fn solve_symmetric_band_on(
     solver: &str,
     kernel: &dyn SymmetricKernel,
     problem: &SymmetricProblem<'_>,
     op: &ShiftInvert<'_>,
+    start_modes: Option<MatRef<'_, f64>>,
     params: &EigenParams,
 ) -> Result<RealModes> {
     let start = Instant::now();
@@ -88,15 +109,27 @@ pub fn solve_symmetric_band_on(
             got: op.dim(),
         });
     }
-    band(solver, kernel, problem, op, params, 0, start)
+    if let Some(s) = start_modes {
+        if s.nrows() != n {
+            return Err(Error::Dimension {
+                context: "symmetric band: the start modes' rows".into(),
+                expected: n,
+                got: s.nrows(),
+            });
+        }
+    }
+    band(solver, kernel, problem, op, start_modes, params, 0, start)
 }
 
-/// The band driver's iteration on the factorized `op` (`factorizations` made for it).
+/// The band driver's iteration on the factorized `op` (`factorizations` made for it),
+/// from `start_modes` when given.
+#[allow(clippy::too_many_arguments)]
 fn band(
     solver: &str,
     kernel: &dyn SymmetricKernel,
     problem: &SymmetricProblem<'_>,
     op: &ShiftInvert<'_>,
+    start_modes: Option<MatRef<'_, f64>>,
     params: &EigenParams,
     factorizations: usize,
     start: Instant,
@@ -117,9 +150,26 @@ fn band(
         ));
         dense_symmetric(problem)?
     } else {
-        let mut nev = params.nev_hint.unwrap_or(24).clamp(1, n - 1);
+        let seeded = start_modes.map_or(0, |s| s.ncols());
+        // a start of `seeded` columns holds the band and the pairs above it a nearby
+        // solve found: as many pairs are asked for, so that none starts from nothing
+        let mut nev = match (params.nev_hint, seeded) {
+            (Some(hint), s) => hint.max(s),
+            (None, 0) => 24,
+            (None, s) => s,
+        }
+        .clamp(1, n - 1);
+        if seeded > 0 {
+            info.notes
+                .push(format!("started from {seeded} modes of a nearby problem"));
+        }
         loop {
-            let out = kernel.largest(op, nev, params.tol, params.max_restarts)?;
+            let out = match start_modes {
+                Some(s) if s.ncols() > 0 => {
+                    kernel.largest_from(op, s, nev, params.tol, params.max_restarts)?
+                }
+                _ => kernel.largest(op, nev, params.tol, params.max_restarts)?,
+            };
             info.iterations += out.iterations;
             info.requested = nev;
             info.converged = out.theta.len();
@@ -178,13 +228,19 @@ fn grown_nev(nev: usize, lam: &[f64], sigma: f64, top: f64) -> usize {
     }
 }
 
+/// Most pairs above the band a solve keeps ([`RealModes::above_band`]): the lowest ones,
+/// enough for the margin the band driver asks beyond the band (a dense solve has the
+/// whole spectrum).
+pub const ABOVE_BAND_KEPT: usize = 8;
+
 /// Finishing step shared by every symmetric backend: keeps the pairs with
 /// `omega^2 <= (2 pi fmax)^2` (and `>= (2 pi fmin)^2` when `fmin > 0`), `M`-normalizes the
 /// vectors, computes the relative residuals (module docs) and sorts by frequency.
-/// `info` is passed through unchanged (the caller sets `time_s`).
+/// `info` is passed through unchanged (the caller sets `time_s`). The lowest pairs above
+/// the band (at most [`ABOVE_BAND_KEPT`]) are kept as [`RealModes::above_band`].
 pub fn finish_real_modes(
     problem: &SymmetricProblem<'_>,
-    omega2: &[f64],
+    omega2_all: &[f64],
     vectors: faer::MatRef<'_, f64>,
     params: &EigenParams,
     info: SolveInfo,
@@ -195,7 +251,7 @@ pub fn finish_real_modes(
     let kn = norm1(problem.k);
     let mn = norm1(problem.m);
     let bottom = (two_pi * params.fmin_hz).powi(2);
-    let mut keep: Vec<(f64, usize)> = omega2
+    let mut keep: Vec<(f64, usize)> = omega2_all
         .iter()
         .enumerate()
         .filter(|(_, &l)| l <= top * (1.0 + 1e-12) && (params.fmin_hz <= 0.0 || l >= bottom))
@@ -228,12 +284,30 @@ pub fn finish_real_modes(
         .collect();
     let omega2: Vec<f64> = keep.iter().map(|p| p.0).collect();
     let freq_hz = omega2.iter().map(|&l| l.max(0.0).sqrt() / two_pi).collect();
+    // the pairs above the band, unit M norm: a nearby problem's start
+    let mut above: Vec<(f64, usize)> = omega2_all
+        .iter()
+        .enumerate()
+        .filter(|(_, &l)| l > top * (1.0 + 1e-12))
+        .map(|(i, &l)| (l, i))
+        .collect();
+    above.sort_by(|a, b| a.0.total_cmp(&b.0));
+    above.truncate(ABOVE_BAND_KEPT);
+    let mut above_band = Mat::from_fn(n, above.len(), |r, c| vectors[(r, above[c].1)]);
+    let m_above = symmetric_times(problem.m, above_band.as_ref());
+    for c in 0..above.len() {
+        let scale = dot(col(&above_band, c), col(&m_above, c)).sqrt();
+        if scale > 0.0 {
+            above_band.col_mut(c).iter_mut().for_each(|v| *v /= scale);
+        }
+    }
     RealModes {
         omega2,
         freq_hz,
         vectors: out_vec,
         residuals,
         info,
+        above_band,
     }
 }
 

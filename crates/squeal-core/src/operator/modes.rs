@@ -63,6 +63,12 @@ pub struct RealModes {
     pub residuals: Vec<f64>,
     /// How the solve went.
     pub info: SolveInfo,
+    /// Converged eigenvectors above the band that the solve found on the way (an
+    /// iterative solver asks for more pairs than the band holds, to see its top), by
+    /// ascending frequency, unit `M` norm; `n x 0` when there are none. With
+    /// [`vectors`](Self::vectors) they start a nearby problem's solve
+    /// ([`crate::EigenSolver::solve_symmetric_on`]).
+    pub above_band: Mat<f64>,
 }
 
 /// Why a solve stopped.

@@ -9,6 +9,7 @@ use crate::eigen::{
 use crate::operator::{ComplexModes, FrictionalOperator, Qep, RealModes};
 use crate::spectral::ShiftInvert;
 use crate::Result;
+use faer::MatRef;
 
 /// An [`EigenSolver`] made of a symmetric and a complex Krylov kernel: normal modes by
 /// [`solve_symmetric_band`], complex modes by [`solve_qep_band`] and frictional operators
@@ -58,9 +59,10 @@ impl<S: SymmetricKernel, C: ComplexKernel> EigenSolver for KernelSolver<S, C> {
         &self,
         problem: &SymmetricProblem<'_>,
         op: &ShiftInvert<'_>,
+        start: Option<MatRef<'_, f64>>,
         params: &EigenParams,
     ) -> Result<RealModes> {
-        solve_symmetric_band_on(self.name, &self.symmetric, problem, op, params)
+        solve_symmetric_band_on(self.name, &self.symmetric, problem, op, start, params)
     }
 
     fn solve_qep(&self, qep: &Qep, params: &EigenParams) -> Result<ComplexModes> {

@@ -1,7 +1,7 @@
 //! The vectors bases start from: the coupled mu = 0 real modes ([`coupled_real_modes`])
 //! and the friction load directions ([`friction_load_directions`]).
 
-use super::{sparse_times, StaticSolver};
+use super::{from_free_dofs, sparse_times, to_free_dofs, StaticSolver};
 use crate::contact::BasisRequest;
 use crate::eigen::{EigenParams, SymmetricProblem};
 use crate::operator::{FrictionalOperator, RealModes};
@@ -17,7 +17,10 @@ pub fn coupled_real_modes(request: &BasisRequest<'_>, cutoff_hz: f64) -> Result<
 /// [`coupled_real_modes`] on the factorization of a [`StaticSolver`] (`K_c + shift M_c`,
 /// the shift-invert operator's `sigma = -shift`): a basis that needs both the real modes
 /// and static responses factorizes once. A modal solver that does not work by
-/// shift-invert ignores the factor.
+/// shift-invert ignores the factor. In a sweep the iteration starts from the previous
+/// contact set's real modes (`request.seed`'s [`crate::Seed::real_modes`], brought to
+/// this contact set by [`super::from_free_dofs`]); a basis hands its own on with
+/// [`real_modes_seed`].
 pub fn coupled_real_modes_on(
     request: &BasisRequest<'_>,
     cutoff_hz: f64,
@@ -51,10 +54,60 @@ fn real_modes(
     match statics {
         Some(s) => {
             let si = s.shift_invert(problem.m)?;
-            request.modal.solve_symmetric_on(&problem, &si, &params)
+            let start = request
+                .seed
+                .and_then(|seed| seed.real_modes.as_ref())
+                .and_then(|w| from_free_dofs(op, w.as_ref()));
+            request.modal.solve_symmetric_on(
+                &problem,
+                &si,
+                start.as_ref().map(|s| s.as_ref()),
+                &params,
+            )
         }
         None => request.modal.solve_symmetric(&problem, &params),
     }
+}
+
+/// How a basis's real modes were found, for its note: the columns the shift-invert
+/// operator was applied to and, when the solve started from a nearby contact set's
+/// modes, that start.
+pub fn real_modes_cost(modes: &RealModes) -> String {
+    let started = modes
+        .info
+        .notes
+        .iter()
+        .find(|n| n.starts_with("started from"));
+    format!(
+        "{} applications of the shift-invert operator{}",
+        modes.info.op_applications,
+        started.map_or(String::new(), |n| format!(", {n}"))
+    )
+}
+
+/// The real modes `modes` of the operator `op` as the next contact set's start
+/// ([`crate::Seed::real_modes`]): the band's modes and the pairs above it the solve
+/// found ([`RealModes::above_band`]), which the next solve needs converged too, on the
+/// free model's DOFs ([`to_free_dofs`]); `None` when `op` has no index map or there
+/// are no modes.
+pub fn real_modes_seed(op: &FrictionalOperator, modes: &RealModes) -> Option<Mat<f64>> {
+    let (band, above) = (&modes.vectors, &modes.above_band);
+    if band.ncols() == 0 {
+        return None;
+    }
+    let above = if above.nrows() == band.nrows() {
+        above.ncols()
+    } else {
+        0
+    };
+    let both = Mat::from_fn(band.nrows(), band.ncols() + above, |r, c| {
+        if c < band.ncols() {
+            band[(r, c)]
+        } else {
+            modes.above_band[(r, c - band.ncols())]
+        }
+    });
+    to_free_dofs(op, both.as_ref())
 }
 
 /// The friction load directions `U = T^T P~t^T` as dense columns (`n_c x nA`). When the

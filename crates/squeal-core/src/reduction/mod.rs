@@ -59,7 +59,10 @@ mod tests;
 mod tied;
 
 pub use crate::linalg::expand;
-pub use candidates::{coupled_real_modes, coupled_real_modes_on, friction_load_directions};
+pub use candidates::{
+    coupled_real_modes, coupled_real_modes_on, friction_load_directions, real_modes_cost,
+    real_modes_seed,
+};
 pub use growing::GrowingBasis;
 pub use mac::mac_real_complex;
 pub use orthonormal::{

@@ -48,7 +48,7 @@ impl ReducedOperator {
     pub fn new(op: &FrictionalOperator, mut basis: Basis) -> Result<Self> {
         let start = Instant::now();
         // a sweep's driver takes the seed for the next point before; nothing here uses it
-        basis.seed = None;
+        basis.seed = crate::contact::Seed::default();
         let m = basis.len();
         let reduced = match basis.projected.take() {
             Some(p) if p.dim() == m => p,

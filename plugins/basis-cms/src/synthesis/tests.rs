@@ -61,6 +61,7 @@ fn modes(k: &Mat<f64>, m: &[f64], count: usize) -> RealModes {
         vectors,
         residuals: vec![0.0; count],
         info: SolveInfo::new("test"),
+        above_band: Mat::zeros(N, 0),
     }
 }
 
