@@ -134,7 +134,8 @@ impl ModalCache {
     }
 
     fn put(&self, key: Key, modes: Arc<RealModes>) {
-        let bytes = modes.vectors.nrows() * modes.vectors.ncols() * std::mem::size_of::<f64>();
+        let columns = modes.vectors.ncols() + modes.above_band.ncols();
+        let bytes = modes.vectors.nrows() * columns * std::mem::size_of::<f64>();
         if bytes > self.budget_bytes {
             return;
         }

@@ -47,7 +47,8 @@
 //! - `rank_tol` (default [`DEFAULT_RANK_TOL`]): relative rank cut of the
 //!   orthonormalization.
 
-use squeal_core::faer::{Mat, MatRef};
+use squeal_core::faer::Mat;
+use squeal_core::linalg::hcat;
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
     coupled_real_modes_on, expand, from_free_dofs, m_orthonormalize, real_modes_cost,
@@ -176,7 +177,7 @@ impl ReductionBasis for ResidueBasis {
             .and_then(|s| s.directions.as_ref())
             .and_then(|s| from_free_dofs(op, s.as_ref()));
         let start = match &seed {
-            Some(s) => concat_columns(modes.vectors.as_ref(), s.as_ref()),
+            Some(s) => hcat(modes.vectors.as_ref(), s.as_ref()),
             None => modes.vectors.clone(),
         };
         let (v, mut dropped) = m_orthonormalize(mc, start.as_ref(), self.rank_tol)?;
@@ -296,16 +297,4 @@ impl ReductionBasis for ResidueBasis {
         basis.notes = notes;
         Ok(basis)
     }
-}
-
-/// `[a | b]`.
-fn concat_columns(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
-    let k = a.ncols();
-    Mat::from_fn(a.nrows(), k + b.ncols(), |r, c| {
-        if c < k {
-            a[(r, c)]
-        } else {
-            b[(r, c - k)]
-        }
-    })
 }

@@ -743,13 +743,7 @@ fn a_nearby_problems_modes_start_the_band_with_fewer_applications() {
     // the band's modes and the pairs above it the solve found
     let (band, above) = (&before.vectors, &before.above_band);
     assert!(above.ncols() > 0 && above.ncols() <= squeal_core::eigen::ABOVE_BAND_KEPT);
-    let start = Mat::from_fn(band.nrows(), band.ncols() + above.ncols(), |r, c| {
-        if c < band.ncols() {
-            band[(r, c)]
-        } else {
-            above[(r, c - band.ncols())]
-        }
-    });
+    let start = squeal_core::linalg::hcat(band.as_ref(), above.as_ref());
     let started = solve(Some(start.as_ref()));
     eprintln!(
         "fresh: {} applications, {} restarts; from the nearby modes ({}): {} applications, {} \

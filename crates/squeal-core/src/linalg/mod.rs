@@ -373,6 +373,16 @@ pub fn check_square_finite(a: SparseRef<'_>, n: usize, what: &str) -> Result<()>
     Ok(())
 }
 
+/// The columns of `a` then those of `b`, side by side: `[a | b]` (the same rows).
+pub fn hcat(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
+    debug_assert_eq!(a.nrows(), b.nrows());
+    let k = a.ncols();
+    let mut out = Mat::<f64>::zeros(a.nrows(), k + b.ncols());
+    out.as_mut().subcols_mut(0, k).copy_from(a);
+    out.as_mut().subcols_mut(k, b.ncols()).copy_from(b);
+    out
+}
+
 /// Expands reduced vectors: `u = V q` (`V` real `n x m`, `q` complex `m x k`).
 pub fn expand(v: MatRef<'_, f64>, q: MatRef<'_, crate::c64>) -> Mat<crate::c64> {
     // One real product V [Re Q, Im Q] (BLAS-3, parallel), then recombined.
@@ -403,6 +413,21 @@ pub fn expand(v: MatRef<'_, f64>, q: MatRef<'_, crate::c64>) -> Mat<crate::c64> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn hcat_puts_the_columns_side_by_side() {
+        let a = Mat::from_fn(3, 2, |i, j| (10 * i + j) as f64);
+        let b = Mat::from_fn(3, 1, |i, _| -(i as f64) - 1.0);
+        let ab = hcat(a.as_ref(), b.as_ref());
+        assert_eq!((ab.nrows(), ab.ncols()), (3, 3));
+        for i in 0..3 {
+            assert_eq!(ab[(i, 0)], a[(i, 0)]);
+            assert_eq!(ab[(i, 1)], a[(i, 1)]);
+            assert_eq!(ab[(i, 2)], b[(i, 0)]);
+        }
+        let none = hcat(a.as_ref(), Mat::<f64>::zeros(3, 0).as_ref());
+        assert_eq!(none, a);
+    }
 
     #[test]
     fn column_split_solves_every_column_once_for_any_thread_count() {

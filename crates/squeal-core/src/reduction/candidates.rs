@@ -4,6 +4,7 @@
 use super::{from_free_dofs, sparse_times, to_free_dofs, StaticSolver};
 use crate::contact::BasisRequest;
 use crate::eigen::{EigenParams, SymmetricProblem};
+use crate::linalg::hcat;
 use crate::operator::{FrictionalOperator, RealModes};
 use crate::{Error, Result};
 use faer::Mat;
@@ -95,19 +96,10 @@ pub fn real_modes_seed(op: &FrictionalOperator, modes: &RealModes) -> Option<Mat
     if band.ncols() == 0 {
         return None;
     }
-    let above = if above.nrows() == band.nrows() {
-        above.ncols()
-    } else {
-        0
-    };
-    let both = Mat::from_fn(band.nrows(), band.ncols() + above, |r, c| {
-        if c < band.ncols() {
-            band[(r, c)]
-        } else {
-            modes.above_band[(r, c - band.ncols())]
-        }
-    });
-    to_free_dofs(op, both.as_ref())
+    if above.nrows() != band.nrows() {
+        return to_free_dofs(op, band.as_ref());
+    }
+    to_free_dofs(op, hcat(band.as_ref(), above.as_ref()).as_ref())
 }
 
 /// The friction load directions `U = T^T P~t^T` as dense columns (`n_c x nA`). When the
