@@ -518,6 +518,63 @@ fn real_modes_started_from_another_contact_sets_need_fewer_solves() {
     assert!(started.info.op_applications < fresh.info.op_applications);
 }
 
+/// `enriched` in the model's static space (its model stage: the static responses as
+/// coordinates there, the basis implicit) spans what the explicit build spans: at two
+/// contact sets, the same modes to 1e-8 with backward errors as small, from as many
+/// columns.
+#[test]
+fn enriched_in_the_static_space_matches_the_explicit_build() {
+    let reg = squeal::registry();
+    let prep = Prepared::new(&reg, coarse(), "coarse").unwrap();
+    let fmax = 3000.0;
+    let mut staged = Method::new(
+        &reg,
+        "enriched",
+        &Params::new(),
+        "dense",
+        "arpack",
+        params(fmax * 1.01),
+    )
+    .unwrap();
+    staged.prepare_stage_on(&prep).unwrap();
+    for mu in [0.3, 0.6] {
+        let eq = prep.equilibrium(&reg, "lcp", "lagrange", mu).unwrap();
+        let op = prep.operator(&eq.eq.active).unwrap();
+        let (implicit, _, _) = staged.solve(&op, mu, true).unwrap();
+        let basis = build_basis(&reg, "enriched", &[], &op, mu, fmax);
+        let explicit = reduced_modes(&reg, &op, &basis, mu, fmax);
+        let notes = &implicit.info.notes;
+        println!(
+            "mu {mu}: {} active pairs, explicit {} columns; {}",
+            eq.eq.active.iter().filter(|&&a| a).count(),
+            basis.len(),
+            notes.join("; ")
+        );
+        assert!(
+            notes.iter().any(|n| n.contains("static space")),
+            "{notes:?}"
+        );
+        let shown = |m: &ComplexModes| {
+            (0..m.len())
+                .filter(|&i| m.freq_hz[i] <= fmax)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(shown(&implicit).len(), shown(&explicit).len());
+        for i in shown(&explicit) {
+            let (j, d) = nearest(&implicit, explicit.lambda[i]);
+            assert!(
+                d <= 1e-8 * explicit.lambda[i].norm(),
+                "mu {mu}: {} against {} ({d:e})",
+                implicit.lambda[j],
+                explicit.lambda[i]
+            );
+        }
+        let (bi, be) = (max_backward(&implicit, fmax), max_backward(&explicit, fmax));
+        println!("backward errors: implicit {bi:.2e}, explicit {be:.2e}");
+        assert!(bi <= 10.0 * be.max(1e-12), "{bi:e} against {be:e}");
+    }
+}
+
 // ------------------------------------------------------------------------------------
 // 3. Failure probing: the backward errors flag the bases that should fail
 // ------------------------------------------------------------------------------------

@@ -6,16 +6,27 @@
 //! vector per active pair), optionally compressed by an SVD in the `M_c` inner product.
 //! Everything is `M_c`-orthonormalized with the rank cut of
 //! [`squeal_core::reduction`] (columns scaled to unit `M_c` norm first, so the static
-//! vectors, of order 1e-9 m per N, survive next to unit-modal-mass modes). The solves
-//! with `K_c` serve the modes (shift-invert at 0) and the static responses; they go
-//! through the free model's factor and the Schur complement on the contact set's pairs
-//! (the model stage [`PairSolves`], built once per model, shared with `residue`), or
-//! through a sparse Cholesky factorization of `K_c` when there is no stage (an operator
-//! read from files). Through the stage the static responses need no solve of their own:
-//! the free model's response to each pair's friction load is solved the first time a
-//! contact set ties the pair and kept, and each contact set corrects the kept ones onto
-//! its ties ([`squeal_core::reduction::TiedSolve::friction_statics`]). The basis's note
-//! says which and gives the time of each step.
+//! vectors, of order 1e-9 m per N, survive next to unit-modal-mass modes).
+//!
+//! The model stage (built once per model) holds the free model's pair solves
+//! ([`PairSolves`]: the factor of `K` and the responses to the candidate pairs' normal
+//! loads) and, without the SVD compression, its static space ([`StaticSpace`]: an
+//! `M`-orthonormal basis `Q` of the responses to every candidate pair's normal and
+//! friction loads, with `Q^T K Q` and the rows the friction parts read). The real modes
+//! are solved through the pair solves (shift-invert at 0: the free factor and the Schur
+//! complement on the contact set's pairs). On an undamped operator the static responses
+//! of a contact set are then coordinates in `Q` (no solve: their ties are corrected on
+//! the pairs), orthonormalized by a dense QR of `2 nR x nA`, and the basis is `[Q W, V]`,
+//! `V` the real modes orthogonalized against `Q W` (a mode inside the static span is
+//! dropped); it stays implicit, the operator projected on it from `Q^T K Q`, products of
+//! `Q^T` with the modes' images and the rows at the pairs, and only the reduced vectors a
+//! solve returns are expanded. Otherwise (a damped operator, the SVD compression, no
+//! stage) the columns are formed: the static responses `K_c^-1 U` from the free model's
+//! kept responses to the friction loads corrected onto the ties
+//! ([`squeal_core::reduction::TiedSolve::friction_statics`]), or through a sparse
+//! Cholesky factorization of `K_c` when there is no stage (an operator read from
+//! files), then the modes and the static responses orthonormalized and projected. The
+//! basis's note says which and gives the time of each step.
 //!
 //! Fixed in mu, not in contact set: built once per contact set (a new active set means
 //! a new `T` and a new basis) and reused across a whole mu sweep
@@ -34,11 +45,13 @@ use squeal_core::linalg::norm2;
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
     coupled_real_modes_on, m_orthonormal_extend, m_orthonormalize, m_svd_compress, real_modes_cost,
-    real_modes_seed, PairSolves, StaticSolver, DEFAULT_RANK_TOL, PAIR_SOLVES_STAGE_KEY,
+    real_modes_seed, PairSolves, StaticSolver, StaticSpace, DEFAULT_RANK_TOL,
+    PAIR_SOLVES_STAGE_KEY,
 };
 use squeal_core::{
     Basis, BasisRequest, Error, FreeModel, ModelStage, Params, ReductionBasis, Registry, Result,
 };
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Name under which the basis is registered.
@@ -97,26 +110,51 @@ impl ReductionBasis for EnrichedBasis {
         NAME
     }
 
-    /// The free model's pair solves: every contact set's `K_c` is solved through them.
+    /// The free model's pair solves (every contact set's `K_c` is solved through them)
+    /// and its static space.
     fn stage_key(&self, _band_top_hz: f64) -> Option<String> {
-        Some(PAIR_SOLVES_STAGE_KEY.into())
+        Some(format!("{PAIR_SOLVES_STAGE_KEY}, and the static space"))
     }
 
+    /// The pair solves of the free model and, unless the SVD compression is asked for,
+    /// its static space.
     fn prepare(&self, free: &FreeModel<'_>) -> Result<Option<ModelStage>> {
-        PairSolves::stage(free)
+        let Some(pairs) = PairSolves::stage(free)? else {
+            return Ok(None);
+        };
+        let pairs = match Arc::downcast::<PairSolves>(pairs) {
+            Ok(p) => p,
+            Err(_) => return Err(Error::Invalid("enriched: pair solves expected".into())),
+        };
+        let space = match self.svd_tol {
+            Some(_) => None,
+            None => StaticSpace::new(free, &pairs)?,
+        };
+        Ok(Some(Arc::new(EnrichedStage { pairs, space })))
     }
 
     /// The responses to every candidate pair's friction load, solved now rather than at
-    /// the first contact set that ties each pair.
+    /// the first contact set that ties each pair (none to solve with a static space).
     fn complete_stage(&self, stage: &ModelStage) -> Result<()> {
-        if let Some(pairs) = PairSolves::in_stage(Some(stage.as_ref())) {
-            pairs.solve_friction_responses();
+        if let Some(st) = stage.downcast_ref::<EnrichedStage>() {
+            if st.space.is_none() {
+                st.pairs.solve_friction_responses();
+            }
         }
         Ok(())
     }
 
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {
         let op = request.op;
+        let stage = request
+            .stage
+            .and_then(|s| s.downcast_ref::<EnrichedStage>());
+        let pairs = stage.map(|s| s.pairs.as_ref());
+        if let Some(space) = stage.and_then(|s| s.space.as_ref()) {
+            if op.cc.is_none() && op.t.is_some() && op.friction_loads.is_some() {
+                return self.build_in_space(request, pairs.expect("with the space"), space);
+            }
+        }
         let mc = op.mc.as_ref();
         let cutoff = self.cutoff_factor * request.band_hz.1;
         // one solver of K_c (through the model stage's pair solves, or a factorization of
@@ -124,7 +162,7 @@ impl ReductionBasis for EnrichedBasis {
         // need K_c itself, and it is positive definite when they exist) and the static
         // responses
         let clock = Instant::now();
-        let mut ks = StaticSolver::tied_or_new(op, PairSolves::in_stage(request.stage), 0.0)?;
+        let mut ks = StaticSolver::tied_or_new(op, pairs, 0.0)?;
         let t_factor = clock.elapsed().as_secs_f64();
         let modes = coupled_real_modes_on(request, cutoff, &ks)?;
         let t_modes = clock.elapsed().as_secs_f64() - t_factor;
@@ -175,6 +213,66 @@ impl ReductionBasis for EnrichedBasis {
             } else {
                 ""
             }
+        ));
+        Ok(basis)
+    }
+}
+
+/// The model stage of `enriched`: the free model's pair solves and, when built, its
+/// static space.
+struct EnrichedStage {
+    pairs: Arc<PairSolves>,
+    space: Option<StaticSpace>,
+}
+
+impl EnrichedBasis {
+    /// The basis of an undamped contact set in the model's static space: its real modes
+    /// solved through the pair solves, its static responses as coordinates in the space
+    /// (no solve, no `n`-row product), the basis implicit with the operator projected on
+    /// it.
+    fn build_in_space(
+        &self,
+        request: &BasisRequest<'_>,
+        pairs: &PairSolves,
+        space: &StaticSpace,
+    ) -> Result<Basis> {
+        let op = request.op;
+        let cutoff = self.cutoff_factor * request.band_hz.1;
+        let clock = Instant::now();
+        let ks = StaticSolver::tied(op, pairs)?;
+        let t_factor = clock.elapsed().as_secs_f64();
+        let modes = coupled_real_modes_on(request, cutoff, &ks)?;
+        let t_modes = clock.elapsed().as_secs_f64() - t_factor;
+        let (vm, dropped_modes) =
+            m_orthonormalize(op.mc.as_ref(), modes.vectors.as_ref(), self.rank_tol)?;
+        let clock = Instant::now();
+        let tied = pairs.on(op)?;
+        let coords = space.tied_statics(&tied);
+        let loads = coords.ncols();
+        let sb = space.basis(
+            op,
+            tied.active(),
+            coords.as_ref(),
+            vm.as_ref(),
+            self.rank_tol,
+        )?;
+        let t_space = clock.elapsed().as_secs_f64();
+        let (ns, ne) = (sb.columns.statics(), sb.columns.explicit());
+        let mut basis = Basis::implicit(Arc::new(sb.columns), sb.projected);
+        basis.seed.real_modes = real_modes_seed(op, &modes);
+        basis.dropped = dropped_modes + sb.dropped_statics + sb.dropped_extra;
+        basis.notes.push(format!(
+            "{NAME}: {ns} static vectors of {loads} friction loads in the model's static \
+             space ({} directions; {} removed by the rank cut) + {ne} real modes up to \
+             {cutoff:.1} Hz (`{}`; {} removed inside the static span or by the rank cut); \
+             {}; times: set-up {t_factor:.2} s, modes {t_modes:.2} s ({}), statics, \
+             orthonormalization and projection {t_space:.2} s",
+            space.dim(),
+            sb.dropped_statics,
+            request.modal.name(),
+            dropped_modes + sb.dropped_extra,
+            ks.method,
+            real_modes_cost(&modes),
         ));
         Ok(basis)
     }

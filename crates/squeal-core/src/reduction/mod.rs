@@ -7,7 +7,9 @@
 //!   ([`friction_load_directions`]) and static responses with one reused factorization
 //!   ([`StaticSolver`]), which the real modes can share ([`coupled_real_modes_on`]), or
 //!   solves with any contact set's `K_c` through one factorization of the free model
-//!   ([`PairSolves`], a model stage);
+//!   ([`PairSolves`], a model stage), and the model's static space, in which every
+//!   contact set's static responses are coordinates and a basis of them stays implicit
+//!   ([`StaticSpace`]);
 //! - projection of every part of a [`FrictionalOperator`](crate::operator::FrictionalOperator) on a basis ([`project`]), or of a
 //!   basis grown column by column with the images of its columns kept ([`GrowingBasis`]), the
 //!   reduced solve with any [`EigenSolver`](crate::EigenSolver), and the expansion of the reduced modes with
@@ -53,6 +55,7 @@ mod orthonormal;
 mod project;
 mod seed;
 mod solve;
+mod static_space;
 mod statics;
 #[cfg(test)]
 mod tests;
@@ -72,6 +75,7 @@ pub use orthonormal::{
 pub use project::{dense_to_sparse, project};
 pub use seed::{from_free_dofs, to_free_dofs};
 pub use solve::{solve_reduced, ReducedOperator, ReducedSolve};
+pub use static_space::{StaticBasis, StaticColumns, StaticSpace};
 pub use statics::{energy_residuals, StaticSolver};
 pub use tied::{PairSolves, TiedSolve, PAIR_SOLVES_LIMIT_BYTES, PAIR_SOLVES_STAGE_KEY};
 

@@ -208,14 +208,7 @@ impl PairSolves {
             .collect();
         let mut loads = Mat::<f64>::zeros(self.dim(), missing.len());
         if !missing.is_empty() {
-            for (c, &i) in missing.iter().enumerate() {
-                let (pin, disc, e) = self.sliding[i];
-                for a in 0..2 {
-                    loads[(pin[a], c)] += e[a];
-                    loads[(disc[a], c)] -= e[a];
-                }
-            }
-            self.factor.solve_in_place(loads.as_mut());
+            self.friction_responses_into(&missing, loads.as_mut());
             for (c, &i) in missing.iter().enumerate() {
                 let col = loads.col(c).try_as_col_major().unwrap().as_slice();
                 kept.x[i] = Some(col.into());
@@ -245,6 +238,34 @@ impl PairSolves {
     /// Number of candidate pairs.
     pub fn pairs(&self) -> usize {
         self.normals.len()
+    }
+
+    /// `Z = K^-1 C^T` (`n x nR`): the free responses to the candidate pairs' unit normal
+    /// loads.
+    pub fn normal_responses(&self) -> faer::MatRef<'_, f64> {
+        self.z.as_ref()
+    }
+
+    /// The normal DOFs `(pin, disc)` of each candidate pair.
+    pub fn normal_dofs(&self) -> &[(usize, usize)] {
+        &self.normals
+    }
+
+    /// Solves the free responses to the friction loads of the candidate pairs `pairs`
+    /// into the columns of `out` (`n x pairs.len()`, one block solve), without keeping
+    /// them.
+    pub fn friction_responses_into(&self, pairs: &[usize], mut out: MatMut<'_, f64>) {
+        out.fill(0.0);
+        for (c, &i) in pairs.iter().enumerate() {
+            let (pin, disc, e) = self.sliding[i];
+            for a in 0..2 {
+                out[(pin[a], c)] += e[a];
+                out[(disc[a], c)] -= e[a];
+            }
+        }
+        if !pairs.is_empty() {
+            self.factor.solve_in_place(out);
+        }
     }
 
     /// Number of DOFs of the free model.
@@ -351,6 +372,26 @@ impl TiedSolve<'_> {
         self.active.len()
     }
 
+    /// The active pairs (candidate indices, ascending: the order of the operator's
+    /// friction loads).
+    pub fn active(&self) -> &[usize] {
+        &self.active
+    }
+
+    /// `G <- S_AA^-1 G` for a block with one row per active pair.
+    pub fn solve_pairs(&self, mut g: MatMut<'_, f64>) {
+        faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+            self.l.as_ref(),
+            g.as_mut(),
+            Par::Seq,
+        );
+        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+            self.l.transpose(),
+            g.as_mut(),
+            Par::Seq,
+        );
+    }
+
     /// `B <- K_c^-1 B`.
     pub fn solve(&self, b: MatMut<'_, f64>) {
         let (n, r) = (self.t.len(), b.ncols());
@@ -409,16 +450,7 @@ impl TiedSolve<'_> {
                 let (p, d) = normals[self.active[i]];
                 f[(p, c)] - f[(d, c)]
             });
-            faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-                self.l.as_ref(),
-                g.as_mut(),
-                Par::Seq,
-            );
-            faer::linalg::triangular_solve::solve_upper_triangular_in_place(
-                self.l.transpose(),
-                g.as_mut(),
-                Par::Seq,
-            );
+            self.solve_pairs(g.as_mut());
             let par = faer::get_global_parallelism();
             for &(k, len) in &self.runs {
                 let zr = self.solves.z.as_ref().subcols(self.active[k], len);
