@@ -267,11 +267,6 @@ impl StaticSpace {
         self.cx.nrows()
     }
 
-    /// Bytes held.
-    pub fn bytes(&self) -> usize {
-        8 * (self.q.nrows() * self.q.ncols() + 4 * self.dim() * self.dim())
-    }
-
     /// The coordinates in `Q` of the tied static responses to the friction loads of the
     /// active pairs of `tied` (`2 nR x nA`, one column per active pair in its order).
     pub fn tied_statics(&self, tied: &TiedSolve<'_>) -> Mat<f64> {
