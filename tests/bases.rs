@@ -520,8 +520,8 @@ fn real_modes_started_from_another_contact_sets_need_fewer_solves() {
 
 /// `enriched` in the model's static space (its model stage: the static responses as
 /// coordinates there, the basis implicit) spans what the explicit build spans: at two
-/// contact sets, the same modes to 1e-8 with backward errors as small, from as many
-/// columns.
+/// contact sets, the same modes to 1e-8 with backward errors as small. With the SVD
+/// compression the same stage leads to the explicit build.
 #[test]
 fn enriched_in_the_static_space_matches_the_explicit_build() {
     let reg = squeal::registry();
@@ -573,6 +573,28 @@ fn enriched_in_the_static_space_matches_the_explicit_build() {
         println!("backward errors: implicit {bi:.2e}, explicit {be:.2e}");
         assert!(bi <= 10.0 * be.max(1e-12), "{bi:e} against {be:e}");
     }
+    // the SVD compression needs the formed columns: the same stage, the explicit build
+    let mut compressed = Method::new(
+        &reg,
+        "enriched",
+        &Params::new().with_num("svd_tol", 1e-3),
+        "dense",
+        "arpack",
+        params(fmax * 1.01),
+    )
+    .unwrap();
+    compressed.prepare_stage_on(&prep).unwrap();
+    let eq = prep.equilibrium(&reg, "lcp", "lagrange", 0.3).unwrap();
+    let op = prep.operator(&eq.eq.active).unwrap();
+    let (modes, _, _) = compressed.solve(&op, 0.3, true).unwrap();
+    let notes = &modes.info.notes;
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.contains("removed by the SVD cut at"))
+            && !notes.iter().any(|n| n.contains("static space")),
+        "{notes:?}"
+    );
 }
 
 // ------------------------------------------------------------------------------------

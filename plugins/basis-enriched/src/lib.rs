@@ -10,7 +10,7 @@
 //!
 //! The model stage (built once per model) holds the free model's pair solves
 //! ([`PairSolves`]: the factor of `K` and the responses to the candidate pairs' normal
-//! loads) and, without the SVD compression, its static space ([`StaticSpace`]: an
+//! loads) and its static space ([`StaticSpace`]: an
 //! `M`-orthonormal basis `Q` of the responses to every candidate pair's normal and
 //! friction loads, with `Q^T K Q` and the rows the friction parts read). The real modes
 //! are solved through the pair solves (shift-invert at 0: the free factor and the Schur
@@ -116,8 +116,8 @@ impl ReductionBasis for EnrichedBasis {
         Some(format!("{PAIR_SOLVES_STAGE_KEY}, and the static space"))
     }
 
-    /// The pair solves of the free model and, unless the SVD compression is asked for,
-    /// its static space.
+    /// The pair solves of the free model and its static space (the stage is shared by
+    /// every parameter set of the basis).
     fn prepare(&self, free: &FreeModel<'_>) -> Result<Option<ModelStage>> {
         let Some(pairs) = PairSolves::stage(free)? else {
             return Ok(None);
@@ -126,10 +126,7 @@ impl ReductionBasis for EnrichedBasis {
             Ok(p) => p,
             Err(_) => return Err(Error::Invalid("enriched: pair solves expected".into())),
         };
-        let space = match self.svd_tol {
-            Some(_) => None,
-            None => StaticSpace::new(free, &pairs)?,
-        };
+        let space = StaticSpace::new(free, &pairs)?;
         Ok(Some(Arc::new(EnrichedStage { pairs, space })))
     }
 
@@ -151,7 +148,8 @@ impl ReductionBasis for EnrichedBasis {
             .and_then(|s| s.downcast_ref::<EnrichedStage>());
         let pairs = stage.map(|s| s.pairs.as_ref());
         if let Some(space) = stage.and_then(|s| s.space.as_ref()) {
-            if op.cc.is_none() && op.t.is_some() && op.friction_loads.is_some() {
+            let undamped = op.cc.is_none() && op.t.is_some() && op.friction_loads.is_some();
+            if undamped && self.svd_tol.is_none() {
                 return self.build_in_space(request, pairs.expect("with the space"), space);
             }
         }

@@ -322,6 +322,14 @@ impl StaticSpace {
                 got: t.len(),
             });
         }
+        if u.ncols() != active.len() || active.iter().any(|&i| i >= self.pairs()) {
+            return Err(Error::Invalid(format!(
+                "static space: {} friction loads for {} active pairs of {} candidates",
+                u.ncols(),
+                active.len(),
+                self.pairs()
+            )));
+        }
         let mut rep = vec![usize::MAX; nc];
         for (j, &c) in t.iter().enumerate() {
             if c < nc && rep[c] == usize::MAX {
@@ -392,14 +400,6 @@ impl StaticSpace {
         );
         // friction parts F_X = U V_X^T: U^T B from the rows of B at U's rows, V_X^T B from
         // the pins' normal rows of X Q and of X (T v)
-        if u.ncols() != active.len() || active.iter().any(|&i| i >= self.pairs()) {
-            return Err(Error::Invalid(format!(
-                "static space: {} friction loads for {} active pairs of {} candidates",
-                u.ncols(),
-                active.len(),
-                self.pairs()
-            )));
-        }
         let urows: Vec<usize> = {
             let mut r: Vec<usize> = (0..u.ncols())
                 .flat_map(|c| u.row_idx_of_col_raw(c).iter().copied())
@@ -433,20 +433,15 @@ impl StaticSpace {
         let vx = |x: usize| -> Mat<f64> {
             let sel = Mat::from_fn(na, self.dim(), |i, k| self.es_q[x][(active[i], k)]);
             let s = mul(sel.as_ref(), w.as_ref());
-            let cols: Vec<Vec<(usize, f64)>> =
-                active.iter().map(|&i| self.es_cols[x][i].clone()).collect();
-            let e = es_times(&cols, vfree.as_ref());
-            Mat::from_fn(
-                na,
-                m,
-                |i, k| {
-                    if k < ns {
-                        s[(i, k)]
-                    } else {
-                        e[(i, k - ns)]
-                    }
-                },
-            )
+            // every candidate pair's row (a few hundred sparse dots), the active ones read
+            let e = es_times(&self.es_cols[x], vfree.as_ref());
+            Mat::from_fn(na, m, |i, k| {
+                if k < ns {
+                    s[(i, k)]
+                } else {
+                    e[(active[i], k - ns)]
+                }
+            })
         };
         let fm = tmul(utb.as_ref(), vx(0).as_ref());
         let fk = tmul(utb.as_ref(), vx(1).as_ref());
