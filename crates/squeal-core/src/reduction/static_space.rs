@@ -69,7 +69,8 @@ impl std::fmt::Debug for StaticSpace {
     }
 }
 
-/// `G = A^T M A` (`c x c`), the `M` images a block of columns at a time.
+/// `G = A^T X A` (`c x c`) for a symmetric `X`, the images `X A` a block of columns at
+/// a time (the upper triangle computed, the lower mirrored).
 fn gram(m: SparseRef<'_>, a: MatRef<'_, f64>) -> Mat<f64> {
     let c = a.ncols();
     let mut g = Mat::<f64>::zeros(c, c);
@@ -219,27 +220,7 @@ impl StaticSpace {
         for (c, &dc) in d.iter().enumerate() {
             r.col_mut(c).iter_mut().for_each(|v| *v *= dc);
         }
-        // Q^T K Q, the K images a block at a time
-        let mut qkq = Mat::<f64>::zeros(nq, nq);
-        let mut c0 = 0;
-        while c0 < nq {
-            let b = BLOCK.min(nq - c0);
-            let kb = symmetric_times(free.k, a.as_ref().subcols(c0, b));
-            matmul(
-                qkq.as_mut().submatrix_mut(0, c0, c0 + b, b),
-                Accum::Replace,
-                a.as_ref().subcols(0, c0 + b).transpose(),
-                kb.as_ref(),
-                1.0,
-                par(),
-            );
-            c0 += b;
-        }
-        for j in 0..nq {
-            for i in j + 1..nq {
-                qkq[(i, j)] = qkq[(j, i)];
-            }
-        }
+        let qkq = gram(free.k, a.as_ref());
         let pins: Vec<usize> = free.pairs.iter().map(|p| p.pin[2]).collect();
         let es_cols = [columns_at(free.m, &pins), columns_at(free.k, &pins)];
         let es_q = [
