@@ -198,11 +198,54 @@ fn bench_json_round_trips_failed_runs() {
     }
 }
 
+/// A basis of the test whose model stage is `PairSolves` under one shared key; its
+/// `complete_stage` solves the friction responses of every candidate pair (what a basis
+/// sharing another's stage adds to it).
+struct SharingStage {
+    completes: bool,
+}
+
+impl squeal::core::ReductionBasis for SharingStage {
+    fn name(&self) -> &str {
+        "sharing"
+    }
+    fn stage_key(&self, _: f64) -> Option<String> {
+        Some("pair solves shared by two test bases".into())
+    }
+    fn prepare(
+        &self,
+        free: &squeal::core::FreeModel<'_>,
+    ) -> squeal::core::Result<Option<squeal::core::ModelStage>> {
+        PairSolves::stage(free)
+    }
+    fn complete_stage(&self, stage: &squeal::core::ModelStage) -> squeal::core::Result<()> {
+        if self.completes {
+            if let Some(p) = PairSolves::in_stage(Some(stage.as_ref())) {
+                p.solve_friction_responses();
+            }
+        }
+        Ok(())
+    }
+    fn build(
+        &self,
+        _: &squeal::core::BasisRequest<'_>,
+    ) -> squeal::core::Result<squeal::core::Basis> {
+        Err(squeal::core::Error::Invalid("not built here".into()))
+    }
+}
+
 #[test]
 fn a_model_stage_shared_by_two_bases_is_completed_before_any_case_is_timed() {
-    // `residue` prepares the pair solves, `enriched` (same stage key) completes them with
-    // the responses to every pair's friction load: no enriched case pays for them
-    let reg = squeal::registry();
+    // two bases with one stage key: whichever prepares it, the one that completes it
+    // (the friction responses of every pair) has done so before any case is timed
+    let mut reg = squeal::registry();
+    for (name, completes) in [("sharing-plain", false), ("sharing-completing", true)] {
+        reg.bases
+            .register(name, "a test basis sharing a stage", move |_: &Params| {
+                let b: Box<dyn squeal::core::ReductionBasis> = Box::new(SharingStage { completes });
+                Ok(b)
+            });
+    }
     let prep = coarse(&reg);
     let set = squeal::contact::ContactSet::new(
         &prep.model,
@@ -211,18 +254,19 @@ fn a_model_stage_shared_by_two_bases_is_completed_before_any_case_is_timed() {
     )
     .unwrap();
     let mut opts = BenchOptions::all(&reg);
-    let mut pair_solves = |bases: &[&str]| {
+    opts.vary = Vec::new();
+    let mut kept = |bases: &[&str]| {
         opts.bases = bases.iter().map(|b| b.to_string()).collect();
         let stages = stages_for(&reg, &opts, &prep.model, &set).unwrap();
         assert_eq!(stages.len(), 1, "one stage for bases {bases:?}");
         stages[0]
             .stage
             .downcast_ref::<PairSolves>()
-            .expect("the shared stage of residue and enriched is the pair solves")
+            .expect("the shared stage is the pair solves")
             .kept_friction_responses()
     };
-    assert_eq!(pair_solves(&["residue", "enriched"]), set.len());
-    assert_eq!(pair_solves(&["enriched"]), set.len());
-    // residue alone needs none of them
-    assert_eq!(pair_solves(&["residue"]), 0);
+    assert_eq!(kept(&["sharing-plain", "sharing-completing"]), set.len());
+    assert_eq!(kept(&["sharing-completing", "sharing-plain"]), set.len());
+    // the plain one alone adds nothing
+    assert_eq!(kept(&["sharing-plain"]), 0);
 }
