@@ -12,7 +12,7 @@
 //!    reused for every iteration (the real modes of the start are computed on it too;
 //!    at shift 0 no factorization: `K_c` is solved through the free model's factor and
 //!    the pairs of the contact set, the model stage
-//!    [`PairSolves`] shared with `enriched`),
+//!    [`PairSolves`]),
 //!    energy-norm residual
 //!    `eps_j = sqrt(d_j^H K_s d_j) / sqrt(u_j^H K_s u_j)`
 //!    ([`squeal_core::reduction::energy_residuals`], formed from the images `K_c V`,
