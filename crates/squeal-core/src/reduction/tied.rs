@@ -26,10 +26,10 @@
 //!
 //! Accuracy: the tied displacement is the difference of the free one and the ties'
 //! correction, so it carries their rounding: on the default rig at mu 0.3 the relative
-//! residuals `|K_c u_c - b_c| / |b_c|` of the `enriched` basis's solves are 4e-12 to
-//! 4e-10. The modal solvers check their eigenpairs on `K_c` and `M_c` (not on the
-//! solves), and a static response is a basis direction, so neither needs more: the
-//! frequencies of the `enriched` sweep of `squeal validate` agree with those on a
+//! residuals `|K_c u_c - b_c| / |b_c|` of the static responses to the friction loads
+//! are 4e-12 to 4e-10. The modal solvers check their eigenpairs on `K_c` and `M_c` (not
+//! on the solves), and a static response is a basis direction, so neither needs more: the
+//! frequencies of an `enriched` sweep built on these solves agree with those on a
 //! factorized `K_c` to 1e-9, their backward errors to the printed digits.
 
 use crate::contact::{FreeModel, ModelStage};
