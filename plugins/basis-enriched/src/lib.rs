@@ -244,16 +244,10 @@ impl EnrichedBasis {
         let (vm, dropped_modes) =
             m_orthonormalize(op.mc.as_ref(), modes.vectors.as_ref(), self.rank_tol)?;
         let clock = Instant::now();
-        let tied = pairs.on(op)?;
-        let coords = space.tied_statics(&tied);
+        let tied = ks.tied_solve().expect("a solver through the pair solves");
+        let coords = space.tied_statics(tied);
         let loads = coords.ncols();
-        let sb = space.basis(
-            op,
-            tied.active(),
-            coords.as_ref(),
-            vm.as_ref(),
-            self.rank_tol,
-        )?;
+        let sb = space.basis(op, tied, coords.as_ref(), vm.as_ref(), self.rank_tol)?;
         let t_space = clock.elapsed().as_secs_f64();
         let (ns, ne) = (sb.columns.statics(), sb.columns.explicit());
         let mut basis = Basis::implicit(Arc::new(sb.columns), sb.projected);

@@ -273,20 +273,16 @@ impl StaticSpace {
     /// The implicit basis of `op` made of the static directions `Q coords` (orthonormalized
     /// with the rank cut) and the explicit columns `extra` (`n_c x e`, `M_c`-orthonormal;
     /// orthogonalized against the static ones, then cut), with `op` projected on it.
-    /// `op` must be undamped, with its index map and friction loads; `active` are its
-    /// tied pairs (candidate indices, in the order of its friction loads' columns,
-    /// [`TiedSolve::active`]).
+    /// `op` must be undamped, with its friction loads; `tied` is its tied solve
+    /// ([`PairSolves::on`]: its active pairs and one free DOF of each constrained DOF).
     pub fn basis(
         &self,
         op: &FrictionalOperator,
-        active: &[usize],
+        tied: &TiedSolve<'_>,
         coords: MatRef<'_, f64>,
         extra: MatRef<'_, f64>,
         rank_tol: f64,
     ) -> Result<StaticBasis> {
-        let t = op.t.as_deref().ok_or_else(|| {
-            Error::Invalid("static space: the operator has no index map T".into())
-        })?;
         let u = op.friction_loads.as_ref().ok_or_else(|| {
             Error::Invalid("static space: the operator has no friction loads".into())
         })?;
@@ -296,11 +292,12 @@ impl StaticSpace {
             ));
         }
         let (n, nc) = (self.q.nrows(), op.dim());
-        if t.len() != n || extra.nrows() != nc || coords.nrows() != self.dim() {
+        let (active, rep) = (tied.active(), tied.rep());
+        if rep.len() != nc || extra.nrows() != nc || coords.nrows() != self.dim() {
             return Err(Error::Dimension {
-                context: "static space: the operator's free DOFs".into(),
-                expected: n,
-                got: t.len(),
+                context: "static space: the operator's constrained DOFs".into(),
+                expected: nc,
+                got: rep.len(),
             });
         }
         if u.ncols() != active.len() || active.iter().any(|&i| i >= self.pairs()) {
@@ -310,17 +307,6 @@ impl StaticSpace {
                 active.len(),
                 self.pairs()
             )));
-        }
-        let mut rep = vec![usize::MAX; nc];
-        for (j, &c) in t.iter().enumerate() {
-            if c < nc && rep[c] == usize::MAX {
-                rep[c] = j;
-            }
-        }
-        if rep.contains(&usize::MAX) {
-            return Err(Error::Invalid(
-                "static space: the index map T leaves a constrained DOF without a free one".into(),
-            ));
         }
         // the static directions, orthonormal in the coordinates of Q
         let ident = identity(self.dim())?;
@@ -442,7 +428,7 @@ impl StaticSpace {
                 q: self.q.clone(),
                 w,
                 v,
-                rep,
+                rep: rep.to_vec(),
             },
             projected,
             dropped_statics,

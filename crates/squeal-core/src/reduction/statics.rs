@@ -82,6 +82,15 @@ impl<'a> StaticSolver<'a> {
         })
     }
 
+    /// The tied solve behind this solver, when it solves through the free model's pairs
+    /// ([`tied`](Self::tied)).
+    pub fn tied_solve(&self) -> Option<&TiedSolve<'a>> {
+        match &self.factor {
+            Backend::Tied(t) => Some(t),
+            Backend::Factor(_) => None,
+        }
+    }
+
     /// [`tied`](Self::tied) when the basis has the free model's `pairs` (its model stage)
     /// and `shift` is 0, else [`new`](Self::new).
     pub fn tied_or_new(

@@ -378,6 +378,11 @@ impl TiedSolve<'_> {
         &self.active
     }
 
+    /// One free DOF of each constrained DOF (the row a free vector is read at).
+    pub fn rep(&self) -> &[usize] {
+        &self.rep
+    }
+
     /// `G <- S_AA^-1 G` for a block with one row per active pair.
     pub fn solve_pairs(&self, mut g: MatMut<'_, f64>) {
         faer::linalg::triangular_solve::solve_lower_triangular_in_place(
