@@ -71,7 +71,7 @@ fn cms_matches_full_order_on_equilibrium_sets_and_zones() {
     let (reg, prep) = setup();
     let mut cms = Method::new(&reg, "cms", &Params::new(), "dense", "arpack", params()).unwrap();
     let stage = cms
-        .prepare_stage(&prep.model, &prep.set)
+        .prepare_stage(&prep.model, &prep.set, None)
         .unwrap()
         .expect("cms has a model stage");
     let fi = synthesis(&stage);
@@ -130,7 +130,10 @@ fn cms_matches_full_order_on_equilibrium_sets_and_zones() {
 fn the_raw_synthesis_is_close_before_the_ritz_step() {
     let (reg, prep) = setup();
     let mut cms = Method::new(&reg, "cms", &Params::new(), "dense", "arpack", params()).unwrap();
-    let stage = cms.prepare_stage(&prep.model, &prep.set).unwrap().unwrap();
+    let stage = cms
+        .prepare_stage(&prep.model, &prep.set, None)
+        .unwrap()
+        .unwrap();
     let fi = synthesis(&stage);
     let mu = 0.7;
     let eq = prep.equilibrium(&reg, "lcp", "lagrange", mu).unwrap();
@@ -189,7 +192,7 @@ fn the_second_order_directions_sharpen_the_ritz_step() {
         let (k, v) = Params::parse_kv(&format!("second_order={second_order}")).unwrap();
         p.0.insert(k, v);
         let mut m = Method::new(&reg, "cms", &p, "dense", "arpack", params()).unwrap();
-        m.prepare_stage(&prep.model, &prep.set).unwrap();
+        m.prepare_stage(&prep.model, &prep.set, None).unwrap();
         let (got, size, _) = m.solve(&op, mu, true).unwrap();
         let (df, ddvr, _) = errors(&reference, &got);
         (df, ddvr, size)
@@ -227,7 +230,7 @@ fn a_prepared_model_computes_its_free_modes_and_synthesis_once() {
     // ... which, built on the condensation's factor of K, synthesizes what one built
     // from scratch does
     let fresh_stage = cms()
-        .prepare_stage(&prep.model, &prep.set)
+        .prepare_stage(&prep.model, &prep.set, None)
         .unwrap()
         .unwrap();
     let fresh = synthesis(&fresh_stage);
@@ -260,7 +263,7 @@ fn cms_projected_on_the_pairs_matches_the_explicit_projection() {
     let method = |projection: &str| {
         let p = Params::new().with("projection", ParamValue::Str(projection.into()));
         let mut m = Method::new(&reg, "cms", &p, "dense", "arpack", params()).unwrap();
-        m.prepare_stage(&prep.model, &prep.set).unwrap();
+        m.prepare_stage(&prep.model, &prep.set, None).unwrap();
         m
     };
     let (mut explicit, mut on_pairs) = (method("full"), method("pairs"));
@@ -334,7 +337,7 @@ fn a_damped_operator_is_projected_the_full_way_under_projection_pairs() {
     let run = |projection: &str| {
         let p = Params::new().with("projection", ParamValue::Str(projection.into()));
         let mut m = Method::new(&reg, "cms", &p, "dense", "arpack", params()).unwrap();
-        m.prepare_stage(&prep.model, &prep.set).unwrap();
+        m.prepare_stage(&prep.model, &prep.set, None).unwrap();
         m.solve(&op, mu, true).unwrap().0
     };
     let (full, pairs) = (run("full"), run("pairs"));

@@ -116,8 +116,27 @@ fn message(e: &anyhow::Error) -> String {
     out.replace('\n', " ")
 }
 
+/// Allocator settings for the zone studies (`sweep macro`, `sweep meso`), whose workers
+/// allocate and free blocks of tens of MB per case: two arenas that keep the memory they
+/// free (no trimming, a 256 MB pad on every heap growth) instead of glibc's defaults, which
+/// return it to the system after each case and fault it in again. A meso case is about
+/// 18 % faster on the 2-core machine for about 0.4 GB more peak memory; the other
+/// commands keep the defaults.
+fn tune_allocator_for_studies() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: mallopt only changes glibc's tunables; called before any worker starts.
+    unsafe {
+        libc::mallopt(libc::M_ARENA_MAX, 2);
+        libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX);
+        libc::mallopt(libc::M_TOP_PAD, 256 << 20);
+    }
+}
+
 fn run() -> Result<()> {
     let cli = Cli::parse();
+    if let Command::Sweep(sweep::SweepCmd::Macro(_) | sweep::SweepCmd::Meso(_)) = &cli.command {
+        tune_allocator_for_studies();
+    }
     opts::install_interrupt_handler();
     let registry = squeal::registry();
     match cli.command {

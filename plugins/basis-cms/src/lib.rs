@@ -166,12 +166,15 @@ impl ReductionBasis for CmsBasis {
 
     /// The free-interface synthesis of the model on its candidate pairs, from the normal
     /// modes up to `modes_factor x` the band top, on the caller's factor of `K` when it
-    /// has one.
+    /// has one; for a caller that announces its number of contact sets, with what pays
+    /// for that many ([`FreeInterface::for_contact_sets`]).
     fn prepare(&self, free: &FreeModel<'_>) -> Result<Option<ModelStage>> {
         let modes = (free.normal_modes)(self.modes_factor * free.band_hz.1)?;
         let (k, m, pairs, factor) = (free.k, free.m, free.pairs, free.k_factor.clone());
         let fi = if self.on_pairs {
             FreeInterface::with_pair_moments(k, m, pairs, &modes, factor)?
+        } else if let Some(sets) = free.contact_sets {
+            FreeInterface::for_contact_sets(k, m, pairs, &modes, factor, sets)?
         } else if let Some(factor) = factor {
             FreeInterface::with_factor(k, m, pairs, &modes, factor)?
         } else {

@@ -162,6 +162,7 @@ pub fn stages_for(
                 set,
                 modal.as_ref(),
                 &params,
+                None,
             )?;
             if let Some(stage) = stage {
                 plugin

@@ -188,9 +188,14 @@ impl Method {
 
     /// Builds the model stage the basis needs (once: a later call keeps the one it has)
     /// for `model` and the candidate pairs `set`, every contact set solved later being a
-    /// subset of them ([`prepare_stage_alone`]). Returns it, shared (`None` when the
-    /// basis has none).
-    pub fn prepare_stage(&mut self, model: &Model, set: &ContactSet) -> Result<Option<ModelStage>> {
+    /// subset of them ([`prepare_stage_alone`]), `contact_sets` of them when the caller
+    /// knows how many. Returns it, shared (`None` when the basis has none).
+    pub fn prepare_stage(
+        &mut self,
+        model: &Model,
+        set: &ContactSet,
+        contact_sets: Option<usize>,
+    ) -> Result<Option<ModelStage>> {
         let Some(basis) = &self.basis else {
             return Ok(None);
         };
@@ -201,6 +206,7 @@ impl Method {
                 set,
                 self.modal.as_ref(),
                 &self.params,
+                contact_sets,
             )?;
         }
         Ok(self.stage.clone())

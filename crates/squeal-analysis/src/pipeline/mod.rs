@@ -220,6 +220,7 @@ impl Prepared {
             &modes,
             modal,
             params,
+            None,
         )?;
         if let Some(stage) = &stage {
             let mut cache = self.free.lock().unwrap_or_else(|p| p.into_inner());

@@ -29,8 +29,10 @@ pub fn stage_keys<'a>(
 /// The model stage of `basis` ([`ReductionBasis::prepare`]) on `model` and the candidate
 /// pairs of `set`, with `k_factor` (a Cholesky factor of the model's `K`, when the caller
 /// has one) and `normal_modes` (the free model's modes up to a frequency); `modal` and
-/// `params` as the stage's solver and tolerances, `params.fmax_hz` the band top. `None`
-/// when the basis has no model stage.
+/// `params` as the stage's solver and tolerances, `params.fmax_hz` the band top;
+/// `contact_sets` the number of contact sets the caller will build on it, when known
+/// ([`FreeModel::contact_sets`]). `None` when the basis has no model stage.
+#[allow(clippy::too_many_arguments)]
 pub fn prepare_stage(
     basis: &dyn ReductionBasis,
     model: &Model,
@@ -39,6 +41,7 @@ pub fn prepare_stage(
     normal_modes: &NormalModes<'_>,
     modal: &dyn EigenSolver,
     params: &EigenParams,
+    contact_sets: Option<usize>,
 ) -> Result<Option<ModelStage>> {
     if basis.stage_key(params.fmax_hz).is_none() {
         return Ok(None);
@@ -53,6 +56,7 @@ pub fn prepare_stage(
         modal,
         band_hz: (params.fmin_hz, params.fmax_hz),
         params,
+        contact_sets,
     };
     basis
         .prepare(&free)
@@ -67,6 +71,7 @@ pub fn prepare_stage_alone(
     set: &ContactSet,
     modal: &dyn EigenSolver,
     params: &EigenParams,
+    contact_sets: Option<usize>,
 ) -> Result<Option<ModelStage>> {
     let modes = |fmax_hz: f64| {
         modal.solve_symmetric(
@@ -82,7 +87,7 @@ pub fn prepare_stage_alone(
             },
         )
     };
-    prepare_stage(basis, model, set, None, &modes, modal, params)
+    prepare_stage(basis, model, set, None, &modes, modal, params, contact_sets)
 }
 
 /// The DOFs of the candidate pairs of `set`, in the synthesis's terms.

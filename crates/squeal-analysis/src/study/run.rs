@@ -256,7 +256,7 @@ pub fn run(
         let t = std::time::Instant::now();
         let all = ContactSet::new(model, &squeal_scene::Zone::Uniform, def.rotation)
             .map_err(PipelineError::from)?;
-        let stage = probe.prepare_stage(model, &all)?;
+        let stage = probe.prepare_stage(model, &all, Some(todo.len()))?;
         profile.add(
             &format!("model stage of `{}`", probe.basis_name),
             t.elapsed().as_secs_f64(),

@@ -51,6 +51,10 @@ pub struct FreeModel<'a> {
     pub band_hz: (f64, f64),
     /// The caller's tolerances and limits.
     pub params: &'a EigenParams,
+    /// How many contact sets the caller will build on this stage, when it knows (a
+    /// study's cases): a stage may then spend more once to spend less per contact set.
+    /// `None` when unknown (one scene, a mu sweep).
+    pub contact_sets: Option<usize>,
 }
 
 /// What a basis computed in its model stage, stored by the caller and handed back

@@ -589,6 +589,7 @@ fn pair_solves(k: &SparseMat, pairs: &[PairDofs]) -> Result<PairSolves> {
         modal: &Dense,
         band_hz: (0.0, 1.0),
         params: &wide_band(),
+        contact_sets: None,
     })
 }
 

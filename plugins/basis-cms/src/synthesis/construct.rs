@@ -3,7 +3,8 @@
 
 use super::pairs::PairMoments;
 use super::{
-    add_pair_load, par, pn_rows, pt_rows, FreeInterface, PairDofs, Stored, STORE_LIMIT_BYTES,
+    add_pair_load, par, pn_rows, pt_rows, FreeInterface, PairDofs, Stored, SECOND_GAPS_LIMIT_BYTES,
+    STORE_LIMIT_BYTES,
 };
 use squeal_core::faer::linalg::matmul::matmul;
 use squeal_core::faer::{Accum, Mat};
@@ -56,6 +57,22 @@ impl FreeInterface {
         Self::build(k, m, pairs, modes, None, store_limit_bytes, false)
     }
 
+    /// [`FreeInterface::with_store_limit`] with the memory limit of the second-order gaps
+    /// too ([`SECOND_GAPS_LIMIT_BYTES`]; 0 never keeps them): the tests' way to reach
+    /// each path.
+    #[cfg(test)]
+    pub(super) fn with_limits(
+        k: SparseRef<'_>,
+        m: SparseRef<'_>,
+        pairs: &[PairDofs],
+        modes: &RealModes,
+        store_limit_bytes: usize,
+        gaps_limit_bytes: usize,
+    ) -> Result<Self> {
+        let limits = (store_limit_bytes, gaps_limit_bytes);
+        Self::build_with(k, m, pairs, modes, None, limits, false)
+    }
+
     /// [`FreeInterface::new`] with the Cholesky factor of the same `K` already computed
     /// (by the contact condensation of the model, [`Condensation::factor`]): no second
     /// factorization.
@@ -69,6 +86,31 @@ impl FreeInterface {
         factor: Arc<Cholesky>,
     ) -> Result<Self> {
         Self::build(k, m, pairs, modes, Some(factor), STORE_LIMIT_BYTES, false)
+    }
+
+    /// [`FreeInterface::new`] (on the given factor of `K` when there is one) for a caller
+    /// that will synthesize `contact_sets` contact sets: when the responses are solved per
+    /// expansion (not stored) and there are at least `nR / 10` contact sets, the gaps of
+    /// the second-order terms on the pairs are kept too ([`keeps_second_gaps`]: `2 nR`
+    /// more solved columns here, `16 nR^2` bytes, one block solve fewer per expansion; the
+    /// same modes to round-off).
+    ///
+    /// [`keeps_second_gaps`]: FreeInterface::keeps_second_gaps
+    pub fn for_contact_sets(
+        k: SparseRef<'_>,
+        m: SparseRef<'_>,
+        pairs: &[PairDofs],
+        modes: &RealModes,
+        factor: Option<Arc<Cholesky>>,
+        contact_sets: usize,
+    ) -> Result<Self> {
+        let gaps = if gaps_pay(pairs.len(), contact_sets) {
+            SECOND_GAPS_LIMIT_BYTES
+        } else {
+            0
+        };
+        let limits = (STORE_LIMIT_BYTES, gaps);
+        Self::build_with(k, m, pairs, modes, factor, limits, false)
     }
 
     /// [`FreeInterface::new`] (on the given factor of `K` when there is one) with the
@@ -95,6 +137,28 @@ impl FreeInterface {
         modes: &RealModes,
         factor: Option<Arc<Cholesky>>,
         store_limit_bytes: usize,
+        with_moments: bool,
+    ) -> Result<Self> {
+        Self::build_with(
+            k,
+            m,
+            pairs,
+            modes,
+            factor,
+            (store_limit_bytes, 0),
+            with_moments,
+        )
+    }
+
+    /// [`Self::build`] with the memory limits of the stored responses and of the
+    /// second-order gaps.
+    fn build_with(
+        k: SparseRef<'_>,
+        m: SparseRef<'_>,
+        pairs: &[PairDofs],
+        modes: &RealModes,
+        factor: Option<Arc<Cholesky>>,
+        (store_limit_bytes, gaps_limit_bytes): (usize, usize),
         with_moments: bool,
     ) -> Result<Self> {
         let start = Instant::now();
@@ -139,6 +203,12 @@ impl FreeInterface {
             yn: Mat::zeros(0, 0),
             yt: Mat::zeros(0, 0),
         });
+        // without stored responses, the gaps of the second-order terms (one more block
+        // solve per block of pairs here, one fewer per expansion)
+        let mut second_gaps = (stored.is_none()
+            && moments.is_none()
+            && 16usize.saturating_mul(nr).saturating_mul(nr) <= gaps_limit_bytes)
+            .then(|| [Mat::<f64>::zeros(nr, nr), Mat::<f64>::zeros(nr, nr)]);
         let mut c0 = 0;
         while c0 < nr {
             let b = BLOCK.min(nr - c0);
@@ -161,6 +231,17 @@ impl FreeInterface {
                     .as_mut()
                     .subcols_mut(c0, b)
                     .copy_from(x.as_ref().subcols(b, b));
+            }
+            if let Some([hn, ht]) = second_gaps.as_mut() {
+                let mut y = squeal_core::linalg::symmetric_times(m, x.as_ref());
+                factor.solve_in_place(y.as_mut());
+                let rows = pn_rows(pairs, y.as_ref());
+                hn.as_mut()
+                    .subcols_mut(c0, b)
+                    .copy_from(rows.as_ref().subcols(0, b));
+                ht.as_mut()
+                    .subcols_mut(c0, b)
+                    .copy_from(rows.as_ref().subcols(b, b));
             }
             let rows = pn_rows(pairs, x.as_ref());
             wfull
@@ -216,6 +297,7 @@ impl FreeInterface {
                 m.val().to_vec(),
             )),
             moments,
+            second_gaps,
             wfull,
             wn,
             wt,
@@ -235,6 +317,12 @@ impl FreeInterface {
     /// solved per expansion from the first-order responses).
     pub fn stores_second_order(&self) -> bool {
         self.stored.as_ref().is_some_and(Stored::second_order)
+    }
+
+    /// Whether the gaps of the second-order terms are kept (responses solved per
+    /// expansion, the second-order directions' tie correction joined to their solve).
+    pub fn keeps_second_gaps(&self) -> bool {
+        self.second_gaps.is_some()
     }
 
     /// Whether the moments of the static responses on the pairs are built (every contact
@@ -295,6 +383,14 @@ impl FreeInterface {
         }
         Ok(active)
     }
+}
+
+/// Whether the second-order gaps pay for `contact_sets` contact sets on `nr` candidate
+/// pairs: they cost `2 nr` solved columns once and save about 20-40 per contact set (the
+/// second-order directions of the modes expanded), so they pay from about `nr / 20`
+/// contact sets; the rule asks for twice that.
+pub(super) fn gaps_pay(nr: usize, contact_sets: usize) -> bool {
+    contact_sets.saturating_mul(10) >= nr
 }
 
 /// The inputs of [`FreeInterface::build`]: pairs present and inside the model, modes and

@@ -50,19 +50,15 @@ impl FreeInterface {
         Mat::from_fn(self.dofs(), k, |i, c| c64::new(u[(i, c)], u[(i, k + c)]))
     }
 
-    /// `Phi e + (Y_n + mu Y_t) r` for the modes `which`, real and imaginary parts side by
-    /// side (`n x 2 which.len()`): with `second = false`, `e = eta - Omega^-2 Q^T r` and
-    /// `Y = K^-1 (Pn^T | Pt^T)` (the expansion); with `second = true`, `e = -Omega^-4 Q^T r`
-    /// and `Y = K^-1 M K^-1 (Pn^T | Pt^T)` (the second-order residual term). When the
-    /// second-order terms are solved, the first-order call also returns `K^-1 B^T r` and the
-    /// second-order one takes it back as `reuse`.
-    fn combine(
+    /// The modal coefficients `e` and the pair loads `r` (region rows) of [`Self::combine`]
+    /// for the modes `which`, restricted to the columns that have a nonzero entry in
+    /// either (real and imaginary parts side by side), and those columns' indices.
+    fn coefficients(
         &self,
         syn: &Synthesized,
         which: &[usize],
         second: bool,
-        reuse: Option<&Mat<f64>>,
-    ) -> (Mat<f64>, Option<Mat<f64>>) {
+    ) -> (Mat<f64>, Mat<f64>, Vec<usize>) {
         let nm = self.modes();
         let k = which.len();
         let mu = syn.mu;
@@ -97,7 +93,29 @@ impl FreeInterface {
                     || (0..self.pairs()).any(|i| rfull[(i, c)] != 0.0)
             })
             .collect();
-        let (coef, rfull) = (select(coef.as_ref(), &live), select(rfull.as_ref(), &live));
+        (
+            select(coef.as_ref(), &live),
+            select(rfull.as_ref(), &live),
+            live,
+        )
+    }
+
+    /// `Phi e + (Y_n + mu Y_t) r` for the modes `which`, real and imaginary parts side by
+    /// side (`n x 2 which.len()`): with `second = false`, `e = eta - Omega^-2 Q^T r` and
+    /// `Y = K^-1 (Pn^T | Pt^T)` (the expansion); with `second = true`, `e = -Omega^-4 Q^T r`
+    /// and `Y = K^-1 M K^-1 (Pn^T | Pt^T)` (the second-order residual term). When the
+    /// second-order terms are solved, the first-order call also returns `K^-1 B^T r` and the
+    /// second-order one takes it back as `reuse`.
+    fn combine(
+        &self,
+        syn: &Synthesized,
+        which: &[usize],
+        second: bool,
+        reuse: Option<&Mat<f64>>,
+    ) -> (Mat<f64>, Option<Mat<f64>>) {
+        let k = which.len();
+        let mu = syn.mu;
+        let (coef, rfull, live) = self.coefficients(syn, which, second);
         // K^-1 B^T r, or K^-1 M K^-1 B^T r
         let mut first = None;
         let mut u = match self
@@ -198,22 +216,19 @@ impl FreeInterface {
         let nr = self.pairs();
         let na = syn.active.len();
         let k = which.len();
+        if na > 0 && self.stored.is_none() {
+            if let Some(gaps) = &self.second_gaps {
+                return self.correction_merged(syn, which, reuse, gaps);
+            }
+        }
         let (mut w, _) = self.combine(syn, which, true, reuse);
         if na > 0 {
             // static correction onto the ties: c = W_AA^-1 Pn_A w, w -= K^-1 Pn_A^T c
-            let waa = Mat::from_fn(na, na, |i, j| self.wfull[(syn.active[i], syn.active[j])]);
             let gaps = Mat::from_fn(na, 2 * k, |i, c| {
                 let p = &self.pairs[syn.active[i]];
                 w[(p.pin[2], c)] - w[(p.disc[2], c)]
             });
-            let lu = waa.partial_piv_lu();
-            let cfix = squeal_core::faer::linalg::solvers::Solve::solve(&lu, &gaps);
-            if !(0..2 * k).all(|c| (0..na).all(|i| cfix[(i, c)].is_finite())) {
-                return Err(Error::Factorization {
-                    what: format!("static contact flexibility ({na} pairs)"),
-                    reason: "singular: a pair repeated".into(),
-                });
-            }
+            let cfix = self.tie_loads(&syn.active, gaps)?;
             let mut cf = Mat::<f64>::zeros(nr, 2 * k);
             for (row, &i) in syn.active.iter().enumerate() {
                 for c in 0..2 * k {
@@ -223,6 +238,88 @@ impl FreeInterface {
             w -= &self.static_response(cf.as_ref(), 0.0);
         }
         Ok(w)
+    }
+
+    /// The normal loads `W_AA^-1 g` on the active pairs that cancel the gaps `g`
+    /// (`nA x c`), `W_AA` the static contact flexibility of the active pairs (symmetric
+    /// positive definite: Cholesky, an error when it is not).
+    fn tie_loads(&self, active: &[usize], gaps: Mat<f64>) -> Result<Mat<f64>> {
+        use squeal_core::faer::linalg::solvers::Solve;
+        let na = active.len();
+        let singular = || Error::Factorization {
+            what: format!("static contact flexibility ({na} pairs)"),
+            reason: "not positive definite: a pair repeated".into(),
+        };
+        let waa = Mat::from_fn(na, na, |i, j| self.wfull[(active[i], active[j])]);
+        let cfix = waa
+            .llt(squeal_core::faer::Side::Lower)
+            .map_err(|_| singular())?
+            .solve(&gaps);
+        if !(0..cfix.ncols()).all(|c| (0..na).all(|i| cfix[(i, c)].is_finite())) {
+            return Err(singular());
+        }
+        Ok(cfix)
+    }
+
+    /// [`Self::correction_parts`] when the responses are solved and the second-order gaps
+    /// are kept: the tie loads come from the gaps `Pn_A (K^-1 M K^-1 B_A^T r + Phi e)`
+    /// before any solve, so that `K^-1 (M K^-1 B_A^T r - Pn_A^T c) + Phi e` takes one block
+    /// solve instead of two.
+    fn correction_merged(
+        &self,
+        syn: &Synthesized,
+        which: &[usize],
+        reuse: Option<&Mat<f64>>,
+        [hn, ht]: &[Mat<f64>; 2],
+    ) -> Result<Mat<f64>> {
+        let (coef, rfull, live) = self.coefficients(syn, which, true);
+        let width = 2 * which.len();
+        let (act, mu) = (&syn.active, syn.mu);
+        let z = match reuse {
+            Some(z) => select(z.as_ref(), &live),
+            None => self.static_response(rfull.as_ref(), mu),
+        };
+        // Pn_A K^-1 M K^-1 B_A^T r + Pn_A Phi e, from the kept gaps
+        let na = act.len();
+        let h = Mat::from_fn(na, na, |i, j| {
+            hn[(act[i], act[j])] + mu * ht[(act[i], act[j])]
+        });
+        let ra = Mat::from_fn(na, live.len(), |i, c| rfull[(act[i], c)]);
+        let pa = Mat::from_fn(na, coef.nrows(), |i, j| self.pn_phi[(act[i], j)]);
+        let mut gaps = Mat::<f64>::zeros(na, live.len());
+        matmul(
+            gaps.as_mut(),
+            Accum::Replace,
+            h.as_ref(),
+            ra.as_ref(),
+            1.0,
+            par(),
+        );
+        matmul(
+            gaps.as_mut(),
+            Accum::Add,
+            pa.as_ref(),
+            coef.as_ref(),
+            1.0,
+            par(),
+        );
+        let cfix = self.tie_loads(act, gaps)?;
+        let mut w = squeal_core::linalg::symmetric_times(self.m.as_ref().as_ref(), z.as_ref());
+        for (row, &i) in act.iter().enumerate() {
+            for c in 0..live.len() {
+                add_pair_load(&mut w, &self.pairs[i], c, -cfix[(row, c)], 0.0);
+            }
+        }
+        self.factor.solve_in_place(w.as_mut());
+        matmul(
+            w.as_mut(),
+            Accum::Add,
+            self.phi.as_ref().as_ref(),
+            coef.as_ref(),
+            1.0,
+            par(),
+        );
+        Ok(scatter(w, &live, width))
     }
 }
 

@@ -63,6 +63,11 @@ pub struct FreeInterface {
     /// The moments of the static responses on the pairs, when built: every contact set's
     /// projection is then assembled on the pairs ([`FreeInterface::project_on_pairs`]).
     moments: Option<pairs::PairMoments>,
+    /// The gaps of the second-order terms, `Pn K^-1 M K^-1 Pn^T` and `Pn K^-1 M K^-1 Pt^T`
+    /// (`nR x nR` each), when the responses are not stored: the second-order directions'
+    /// static correction onto the ties is then known before their solve, which it joins
+    /// (one block solve per expansion fewer).
+    second_gaps: Option<[Mat<f64>; 2]>,
     /// Full static `Pn K^-1 Pn^T` (`nR x nR`, m/N).
     wfull: Mat<f64>,
     /// Residual `Pn G Pn^T` (`nR x nR`, m/N).
@@ -96,6 +101,11 @@ impl Stored {
 
 /// Largest memory (bytes) [`FreeInterface::new`] spends on stored static responses.
 pub const STORE_LIMIT_BYTES: usize = 3 << 30;
+
+/// Largest memory (bytes) of the second-order gaps kept when the responses are not
+/// stored ([`FreeInterface::for_contact_sets`]; `16 nR^2` bytes: 0.35 GiB for 4,761
+/// pairs).
+pub const SECOND_GAPS_LIMIT_BYTES: usize = 1 << 30;
 
 fn par() -> Par {
     squeal_core::faer::get_global_parallelism()

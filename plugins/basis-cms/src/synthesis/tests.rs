@@ -223,25 +223,33 @@ fn solved_and_stored_responses_expand_alike() {
     // the memory-light ways (static responses solved per expansion, or stored without
     // their second-order terms) against the one that stores both
     let (k, m) = model();
-    let build = |limit: usize| {
-        FreeInterface::with_store_limit(
+    let build = |limit: usize, gaps: usize| {
+        FreeInterface::with_limits(
             sparse(&k).as_ref(),
             mass(&m).as_ref(),
             &pairs(),
             &modes(&k, &m, 12),
             limit,
+            gaps,
         )
         .unwrap()
     };
     let first_only = 24 * N * pairs().len();
-    let (stored, partly, solved) = (build(usize::MAX), build(first_only), build(0));
+    let (stored, partly) = (build(usize::MAX, usize::MAX), build(first_only, usize::MAX));
+    // solved, with the second-order gaps kept (the correction merged into one solve) and
+    // without
+    let (solved, unmerged) = (build(0, usize::MAX), build(0, 0));
     assert!(stored.stores_responses() && stored.stores_second_order());
     assert!(partly.stores_responses() && !partly.stores_second_order());
-    assert!(!solved.stores_responses() && !solved.stores_second_order());
+    for s in [&solved, &unmerged] {
+        assert!(!s.stores_responses() && !s.stores_second_order());
+    }
+    assert!(solved.keeps_second_gaps() && !unmerged.keeps_second_gaps());
+    assert!(!stored.keeps_second_gaps() && !partly.keeps_second_gaps());
     let active = [0, 2, 3];
     let a = stored.synthesize(&active, 0.6).unwrap();
     let which: Vec<usize> = (0..a.s.len()).collect();
-    for other in [&partly, &solved] {
+    for other in [&partly, &solved, &unmerged] {
         let b = other.synthesize(&active, 0.6).unwrap();
         // the expansion and its correction together (the shared static response), too
         let (eb, cb) = other.expand_with_correction(&b, &which).unwrap();
@@ -317,4 +325,23 @@ fn pair_moments_beyond_their_memory_limit_are_refused() {
         err.contains("projection") && err.contains("4 candidate pairs"),
         "{err}"
     );
+}
+
+#[test]
+fn second_gaps_are_kept_for_many_contact_sets_only() {
+    use super::construct::gaps_pay;
+    assert!(gaps_pay(4761, 1400) && gaps_pay(1681, 280));
+    assert!(!gaps_pay(4761, 280) && !gaps_pay(1681, 10));
+    // a model whose responses are stored keeps no gaps, whatever the number of sets
+    let (k, m) = model();
+    let fi = FreeInterface::for_contact_sets(
+        sparse(&k).as_ref(),
+        mass(&m).as_ref(),
+        &pairs(),
+        &modes(&k, &m, 12),
+        None,
+        1000,
+    )
+    .unwrap();
+    assert!(fi.stores_responses() && !fi.keeps_second_gaps());
 }
