@@ -117,7 +117,8 @@ impl FreeInterface {
     /// moments of the static responses on the pairs as well, so that every contact set's
     /// operator can be projected on the pairs alone ([`FreeInterface::project_on_pairs`]):
     /// three more block solves per block of pairs, and `288 nR^2` bytes (an error beyond
-    /// [`PAIR_MOMENTS_LIMIT_BYTES`]).
+    /// [`PAIR_MOMENTS_LIMIT_BYTES`]). The responses themselves are not stored: the
+    /// projection on the pairs does not use them.
     ///
     /// [`PAIR_MOMENTS_LIMIT_BYTES`]: super::PAIR_MOMENTS_LIMIT_BYTES
     pub fn with_pair_moments(
@@ -194,8 +195,11 @@ impl FreeInterface {
         // kept when they fit
         let mut wfull = Mat::<f64>::zeros(nr, nr);
         let mut wt = Mat::<f64>::zeros(nr, nr);
-        // the first-order responses take 16 n nR bytes, the second-order terms as much again
-        let store = 16usize.saturating_mul(n).saturating_mul(nr) <= store_limit_bytes;
+        // the first-order responses take 16 n nR bytes, the second-order terms as much
+        // again; with the moments nothing is stored: the projection on the pairs does not
+        // use them (a damped operator, projected the full way, solves them per case)
+        let store =
+            !with_moments && 16usize.saturating_mul(n).saturating_mul(nr) <= store_limit_bytes;
         let store_second = 32usize.saturating_mul(n).saturating_mul(nr) <= store_limit_bytes;
         let mut stored = store.then(|| Stored {
             zn: Mat::zeros(n, nr),

@@ -289,7 +289,7 @@ fn pairs_projection_is_the_projection_of_its_columns() {
         None,
     )
     .unwrap();
-    assert!(fi.has_pair_moments());
+    assert!(fi.has_pair_moments() && !fi.stores_responses());
     let md = Mat::from_fn(N, N, |i, j| if i == j { m[i] } else { 0.0 });
     let active = [1, 3];
     for second_order in [false, true] {
