@@ -11,7 +11,7 @@
 #                   off-centre zones
 #   meso-c2         mesoscopic plateaus in the coupling-2 region (0.2 mm grid), 70 % of the
 #                   patches in contact
-#   meso-c2-f0.5    the same with 50 % of the patches in contact
+#   meso-c2-f0.5    the same with 50 % of the patches in contact, 60 layouts per size
 #   meso-c1         mesoscopic plateaus in the coupling-1 region (0.5 mm grid)
 #   fraction        the unstable share against the fraction of patches in contact, both
 #                   couplings, one patch size each (1 mm and 2 mm), 10 layouts per fraction
@@ -52,7 +52,7 @@ case "$name" in
   meso-c2-f0.5)
     [ -d out/meso-c2-f0.5 ] && resume=(--resume)
     $squeal sweep meso scenes/pin-on-disc-meso.toml --coupling 2 --basis cms --jobs 2 \
-      --fraction 0.5 --out out/meso-c2-f0.5 "${resume[@]}" "$@" ;;
+      --fraction 0.5 --layouts 60 --out out/meso-c2-f0.5 "${resume[@]}" "$@" ;;
   meso-c1)
     [ -d out/meso-c1 ] && resume=(--resume)
     $squeal sweep meso scenes/pin-on-disc-meso-c1.toml --coupling 1 --basis cms --jobs 2 \
