@@ -347,8 +347,14 @@ fn a_damped_operator_is_projected_the_full_way_under_projection_pairs() {
         .iter()
         .any(|n| n.contains("projected on the pairs")));
     assert_eq!(full.len(), pairs.len());
+    // the same basis but for round-off: the `pairs` stage solves the static responses per
+    // case where the `full` one stores them, and the orthonormalization's rank cut may then
+    // keep or drop a nearly dependent direction (up to 4e-8 relative here, on the modes
+    // above the band); a damped operator projected on the pairs, its damping lost, would
+    // move the real parts by their whole size
     for (a, b) in full.lambda.iter().zip(&pairs.lambda) {
-        assert!((a - b).norm() <= 1e-10 * a.norm(), "{a} vs {b}");
+        assert!((a - b).norm() <= 1e-6 * a.norm(), "{a} vs {b}");
+        assert!((a.re - b.re).abs() <= 1e-3 * a.re.abs(), "{a} vs {b}");
     }
     assert!(pairs.lambda.iter().any(|l| l.re < 0.0), "no damped mode");
 }
