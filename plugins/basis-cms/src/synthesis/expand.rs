@@ -216,10 +216,9 @@ impl FreeInterface {
         let nr = self.pairs();
         let na = syn.active.len();
         let k = which.len();
-        if na > 0 && self.stored.is_none() {
-            if let Some(gaps) = &self.second_gaps {
-                return self.correction_merged(syn, which, reuse, gaps);
-            }
+        // the gaps are kept only when the responses are not stored
+        if let Some(gaps) = self.second_gaps.as_ref().filter(|_| na > 0) {
+            return self.correction_merged(syn, which, reuse, gaps);
         }
         let (mut w, _) = self.combine(syn, which, true, reuse);
         if na > 0 {
