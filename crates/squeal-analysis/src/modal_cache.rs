@@ -121,6 +121,14 @@ impl ModalCache {
         self.len() == 0
     }
 
+    /// Drops every kept solve (the hit count stays).
+    pub fn clear(&self) {
+        self.entries
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .clear();
+    }
+
     fn get(&self, key: &Key) -> Option<Arc<RealModes>> {
         let entries = self.entries.lock().unwrap_or_else(|p| p.into_inner());
         let found = entries

@@ -200,13 +200,20 @@ pub fn peak_rss_mb() -> Option<f64> {
 }
 
 /// Peak resident memory (MB) since the previous call (or the process's start), then the
-/// mark reset to the memory resident now (Linux: `VmHWM` of `/proc/self/status`, reset by
-/// writing `5` to `/proc/self/clear_refs`), so each stage of a run gets its own peak.
+/// memory the allocator holds free returned to the system (glibc's `malloc_trim`: freed
+/// blocks inside its heaps stay resident otherwise) and the mark reset to the memory
+/// resident now (Linux: `VmHWM` of `/proc/self/status`, reset by writing `5` to
+/// `/proc/self/clear_refs`), so each stage of a run gets its own peak.
 /// After a call, [`peak_rss_mb`] gives the peak since that call, not the process's: a run
 /// that takes stage peaks reports the largest of them as its peak. `None` where the files
 /// do not exist; when the reset is refused the peaks are cumulative (still upper bounds).
 pub fn take_peak_rss_mb() -> Option<f64> {
     let peak = peak_rss_mb()?;
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only returns free pages of glibc's heaps to the system.
+    unsafe {
+        libc::malloc_trim(0);
+    }
     let _ = std::fs::write("/proc/self/clear_refs", "5");
     Some(peak)
 }

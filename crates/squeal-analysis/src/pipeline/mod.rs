@@ -242,6 +242,17 @@ impl Prepared {
             .retain(|(k, _)| keep.contains(k));
     }
 
+    /// Drops everything kept between stages: the model stages, the free model's normal
+    /// modes and the real modes of the tied systems ([`ModalCache`]), for a stage that
+    /// needs none of them (full-order solves); later stages build them again.
+    pub fn release_kept(&self) {
+        let mut free = self.free.lock().unwrap_or_else(|p| p.into_inner());
+        free.stages.clear();
+        free.modes = None;
+        drop(free);
+        self.modal_cache.clear();
+    }
+
     /// The real modes of the tied systems solved on this model so far, for
     /// [`Method::share_modal_cache`].
     pub fn modal_cache(&self) -> Arc<ModalCache> {

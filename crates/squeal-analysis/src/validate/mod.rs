@@ -287,13 +287,22 @@ pub fn run(
         // gone once no sweep ahead works from it (the references reuse the kept modes)
         let ahead = s.sweeps[i + 1..].iter().map(|(b, _)| b.as_str());
         prep.release_stages_except(&crate::pipeline::stage_keys(registry, ahead, band[1])?);
-        kept.push((basis.clone(), sweep.kept));
+        // the references compare eigenvalues only: the mode shapes (n x modes, complex,
+        // per basis and reference mu) are not kept for them
+        let values = sweep.kept.into_iter().map(|(mu, mut m)| {
+            m.vectors = squeal_core::faer::Mat::zeros(0, 0);
+            m.left_vectors = None;
+            (mu, m)
+        });
+        kept.push((basis.clone(), values.collect::<Vec<_>>()));
         sweeps.push((basis.clone(), *step, summary));
         stage(&format!("sweep {basis} (step {step})"), &mut lap);
     }
 
-    // 5. full-order reference points
+    // 5. full-order reference points: they need none of what the sweeps kept (model
+    // stages, free modes, the tied systems' real modes)
     hooks.stage(5, n, "full-order reference points");
+    prep.release_kept();
     let references = references(registry, &prep, s, band, &kept)?;
     stage("full-order references", &mut lap);
 

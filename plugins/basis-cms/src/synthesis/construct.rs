@@ -33,8 +33,10 @@ impl FreeInterface {
     /// definite) for the candidate `pairs`, with the free-interface `modes` (of the same
     /// `(K, M)`, `M`-orthonormal, e.g. from an [`EigenSolver`](squeal_core::EigenSolver) up to a
     /// cutoff above the band). The static responses of the pairs are stored when they fit
-    /// in [`STORE_LIMIT_BYTES`] (and their second-order terms when those fit too), otherwise
-    /// solved for each expansion.
+    /// in [`STORE_LIMIT_BYTES`] (and their second-order terms when both fit in
+    /// [`STORE_SECOND_LIMIT_BYTES`]), otherwise solved for each expansion.
+    ///
+    /// [`STORE_SECOND_LIMIT_BYTES`]: super::STORE_SECOND_LIMIT_BYTES
     pub fn new(
         k: SparseRef<'_>,
         m: SparseRef<'_>,
@@ -200,7 +202,8 @@ impl FreeInterface {
         // use them (a damped operator, projected the full way, solves them per case)
         let store =
             !with_moments && 16usize.saturating_mul(n).saturating_mul(nr) <= store_limit_bytes;
-        let store_second = 32usize.saturating_mul(n).saturating_mul(nr) <= store_limit_bytes;
+        let store_second = 32usize.saturating_mul(n).saturating_mul(nr)
+            <= store_limit_bytes.min(super::STORE_SECOND_LIMIT_BYTES);
         let mut stored = store.then(|| Stored {
             zn: Mat::zeros(n, nr),
             zt: Mat::zeros(n, nr),

@@ -16,8 +16,8 @@
 //! `Pn G Pn^T`, `Pn G Pt^T` of the candidate pairs are computed once (one Cholesky
 //! factorization of `K`, kept, and `2 nR` solves whose pair rows alone are kept, so the
 //! memory is `O(nR^2)`, not `O(n nR)`; the whole responses `K^-1 (Pn^T | Pt^T)` are stored
-//! too when they fit [`STORE_LIMIT_BYTES`], and their second-order terms when those fit as
-//! well): a new contact
+//! too when they fit [`STORE_LIMIT_BYTES`], and their second-order terms when both fit
+//! [`STORE_SECOND_LIMIT_BYTES`]): a new contact
 //! set or mu then costs one `nA x nA` LU, one `m x m` eigen decomposition and the
 //! expansion `u = Phi (eta - Omega^-2 Q^T r) + K^-1 B_A^T r` (products with the stored
 //! responses, or block solves for the modes expanded), which satisfies `Pn_A u = 0`
@@ -101,6 +101,12 @@ impl Stored {
 
 /// Largest memory (bytes) [`FreeInterface::new`] spends on stored static responses.
 pub const STORE_LIMIT_BYTES: usize = 3 << 30;
+
+/// Largest memory (bytes) of the stored static responses with their second-order terms
+/// (`32 n nR` bytes). Above it the second-order terms are solved per expansion (one block
+/// solve of the modes expanded): the default rig's 441 pairs would take 2.3 GiB, as much
+/// as the rest of its model.
+pub const STORE_SECOND_LIMIT_BYTES: usize = 2 << 30;
 
 /// Largest memory (bytes) of the second-order gaps kept when the responses are not
 /// stored ([`FreeInterface::for_contact_sets`]; `16 nR^2` bytes: 0.35 GiB for 4,761
