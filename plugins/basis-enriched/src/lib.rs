@@ -127,6 +127,15 @@ impl ReductionBasis for EnrichedBasis {
             Err(_) => return Err(Error::Invalid("enriched: pair solves expected".into())),
         };
         let space = StaticSpace::new(free, &pairs)?;
+        // the space holds Z = K^-1 C^T in its basis: the pair solves give up their copy
+        let pairs = match (&space, Arc::try_unwrap(pairs)) {
+            (Some(sp), Ok(mut own)) => {
+                own.share_normals_with(sp)?;
+                Arc::new(own)
+            }
+            (_, Ok(own)) => Arc::new(own),
+            (_, Err(shared)) => shared,
+        };
         Ok(Some(Arc::new(EnrichedStage { pairs, space })))
     }
 

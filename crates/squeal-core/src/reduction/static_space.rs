@@ -18,6 +18,9 @@
 //! operator's constrained matrices use those rows: `(Q W)_c^T x = W^T Q^T (x` scattered to
 //! those free DOFs`)`.
 //!
+//! `Q` holds `Z` too: `Z = Q_1 R_11` (`R` is upper triangular), so the pair solves it was
+//! built on can give up their copy ([`PairSolves::share_normals_with`]).
+//!
 //! `Q` is computed by Cholesky QR twice (the second pass restores orthonormality to
 //! rounding when `[Z | X]` is ill-conditioned) on columns scaled to unit `M` norm; when a
 //! pass's Gram matrix is not numerically positive definite (dependent responses) there is
@@ -177,9 +180,7 @@ impl StaticSpace {
             return Ok(None);
         }
         let mut a = Mat::<f64>::zeros(n, nq);
-        a.as_mut()
-            .subcols_mut(0, nr)
-            .copy_from(pairs.normal_responses());
+        pairs.normal_responses_into(a.as_mut().subcols_mut(0, nr));
         let all: Vec<usize> = (0..nr).collect();
         pairs.friction_responses_into(&all, a.as_mut().subcols_mut(nr, nr));
         let normals = pairs.normal_dofs();
@@ -246,6 +247,16 @@ impl StaticSpace {
     /// Number of candidate pairs.
     pub fn pairs(&self) -> usize {
         self.cx.nrows()
+    }
+
+    /// `Q` and the leading `nR x nR` block `R_11` of `R`: `Z = Q_1 R_11`
+    /// ([`PairSolves::share_normals_with`]).
+    pub(crate) fn normal_factors(&self) -> (Arc<Mat<f64>>, Mat<f64>) {
+        let nr = self.pairs();
+        (
+            self.q.clone(),
+            self.r.as_ref().submatrix(0, 0, nr, nr).to_owned(),
+        )
     }
 
     /// The coordinates in `Q` of the tied static responses to the friction loads of the

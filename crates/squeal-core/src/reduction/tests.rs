@@ -714,6 +714,67 @@ fn friction_statics_from_the_kept_free_responses_match_a_solve_of_the_loads() {
 }
 
 #[test]
+fn tied_solves_through_the_static_space_match_those_on_the_kept_responses() {
+    let (k, pairs, _, _) = tied_model(&[]);
+    let n = k.nrows();
+    let m = sparse(Mat::<f64>::identity(n, n).as_ref());
+    let modes = |_: f64| -> Result<RealModes> { unreachable!("tied solves need no modes") };
+    let params = wide_band();
+    let free = FreeModel {
+        k: k.as_ref(),
+        m: m.as_ref(),
+        pairs: &pairs,
+        k_factor: None,
+        normal_modes: &modes,
+        modal: &Dense,
+        band_hz: (0.0, 1.0),
+        params: &params,
+        contact_sets: None,
+    };
+    let kept = PairSolves::new(&free).unwrap();
+    let mut shared = PairSolves::new(&free).unwrap();
+    let space = StaticSpace::new(&free, &shared)
+        .unwrap()
+        .expect("independent responses");
+    shared.share_normals_with(&space).unwrap();
+    // Z = Q_1 R_11 is the kept Z
+    let (mut z1, mut z2) = (Mat::<f64>::zeros(n, 4), Mat::<f64>::zeros(n, 4));
+    kept.normal_responses_into(z1.as_mut());
+    shared.normal_responses_into(z2.as_mut());
+    let scale = z1.norm_max();
+    assert!(scale > 0.0);
+    assert!((&z1 - &z2).norm_max() <= 1e-13 * scale);
+    // and the tied solves agree, whichever pairs are active (the last one or not)
+    for active in [vec![0, 2, 3], vec![1], vec![0, 1, 2, 3], vec![2], vec![]] {
+        let (_, _, op, kc) = tied_model(&active);
+        let b = Rng(11).mat(op.dim(), 3);
+        let (mut x, mut y) = (b.clone(), b.clone());
+        StaticSolver::tied(&op, &kept)
+            .unwrap()
+            .solve_in_place(x.as_mut());
+        StaticSolver::tied(&op, &shared)
+            .unwrap()
+            .solve_in_place(y.as_mut());
+        let scale = x.norm_max();
+        assert!(
+            (&x - &y).norm_max() <= 1e-12 * scale,
+            "active {active:?}: {:e} of {scale:e}",
+            (&x - &y).norm_max()
+        );
+        let worst = (&(&kc * &y) - &b).norm_max();
+        assert!(worst <= 1e-9, "active {active:?}: residual {worst:e}");
+    }
+    // a space of other pair solves is refused
+    let (k2, pairs2, _, _) = tied_model(&[]);
+    let other = PairSolves::new(&FreeModel {
+        pairs: &pairs2[..3],
+        k: k2.as_ref(),
+        ..free
+    });
+    assert!(other.unwrap().share_normals_with(&space).is_err());
+}
+
+#[test]
 fn tied_solves_refuse_an_operator_they_do_not_describe() {
     let (k, pairs, mut op, _) = tied_model(&[0, 2]);
     let solves = pair_solves(&k, &pairs).unwrap();

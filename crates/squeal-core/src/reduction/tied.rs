@@ -53,7 +53,7 @@ pub struct PairSolves {
     factor: Arc<Cholesky>,
     /// Normal (`z`) DOFs `(pin, disc)` of each candidate pair, free numbering.
     normals: Vec<(usize, usize)>,
-    z: Mat<f64>,
+    z: Normals,
     s: Mat<f64>,
     /// In-plane DOFs of each candidate pair's pin and disc node and its sliding direction:
     /// its friction load is `+e` on the pin's DOFs and `-e` on the disc's.
@@ -63,6 +63,24 @@ pub struct PairSolves {
     /// Wall time of the construction (s), the factorization of `K` included when it was
     /// not given.
     pub time_s: f64,
+}
+
+/// `Z = K^-1 C^T`: kept, or as `Q_1 R_11` in a static space's basis once one is built on
+/// the same responses ([`PairSolves::share_normals_with`]: `[Z | X] = Q R` with `R` upper
+/// triangular, so `Z = Q_1 R_11`, `Q_1` the first `nR` columns of `Q`), which saves its
+/// `n nR` values.
+enum Normals {
+    Kept(Mat<f64>),
+    InSpace { q: Arc<Mat<f64>>, r11: Mat<f64> },
+}
+
+impl Normals {
+    fn nrows(&self) -> usize {
+        match self {
+            Normals::Kept(z) => z.nrows(),
+            Normals::InSpace { q, .. } => q.nrows(),
+        }
+    }
 }
 
 /// Bytes of the responses `Z` of the free model's candidate pairs.
@@ -155,7 +173,7 @@ impl PairSolves {
         Ok(Self {
             factor,
             normals,
-            z,
+            z: Normals::Kept(z),
             s,
             sliding,
             friction: Mutex::new(FrictionResponses { x: Vec::new() }),
@@ -240,10 +258,40 @@ impl PairSolves {
         self.normals.len()
     }
 
-    /// `Z = K^-1 C^T` (`n x nR`): the free responses to the candidate pairs' unit normal
-    /// loads.
-    pub fn normal_responses(&self) -> faer::MatRef<'_, f64> {
-        self.z.as_ref()
+    /// `Z = K^-1 C^T` (`n x nR`), the free responses to the candidate pairs' unit normal
+    /// loads, written into `out`.
+    pub fn normal_responses_into(&self, mut out: MatMut<'_, f64>) {
+        match &self.z {
+            Normals::Kept(z) => out.copy_from(z.as_ref()),
+            Normals::InSpace { q, r11 } => {
+                let nr = r11.nrows();
+                matmul(
+                    out,
+                    Accum::Replace,
+                    q.as_ref().subcols(0, nr),
+                    r11.as_ref(),
+                    1.0,
+                    faer::get_global_parallelism(),
+                );
+            }
+        }
+    }
+
+    /// Gives up the kept `Z` for its form `Q_1 R_11` in `space`, a static space built on
+    /// these pair solves ([`super::StaticSpace::new`]): `n nR` values fewer, and every
+    /// tied solve's correction one product with `Q_1` (the columns up to the last active
+    /// pair) instead of with `Z_A`.
+    pub fn share_normals_with(&mut self, space: &super::StaticSpace) -> Result<()> {
+        let (q, r11) = space.normal_factors();
+        if q.nrows() != self.dim() || r11.nrows() != self.pairs() {
+            return Err(Error::Dimension {
+                context: "tied solves: the static space of other pair solves".into(),
+                expected: self.pairs(),
+                got: r11.nrows(),
+            });
+        }
+        self.z = Normals::InSpace { q, r11 };
+        Ok(())
     }
 
     /// The normal DOFs `(pin, disc)` of each candidate pair.
@@ -457,16 +505,51 @@ impl TiedSolve<'_> {
             });
             self.solve_pairs(g.as_mut());
             let par = faer::get_global_parallelism();
-            for &(k, len) in &self.runs {
-                let zr = self.solves.z.as_ref().subcols(self.active[k], len);
-                matmul(
-                    f.as_mut(),
-                    Accum::Add,
-                    zr,
-                    g.as_ref().subrows(k, len),
-                    -1.0,
-                    par,
-                );
+            match &self.solves.z {
+                Normals::Kept(z) => {
+                    for &(k, len) in &self.runs {
+                        let zr = z.as_ref().subcols(self.active[k], len);
+                        matmul(
+                            f.as_mut(),
+                            Accum::Add,
+                            zr,
+                            g.as_ref().subrows(k, len),
+                            -1.0,
+                            par,
+                        );
+                    }
+                }
+                Normals::InSpace { q, r11 } => {
+                    // Z_A g = Q_1 (R_11 E_A g), R_11 upper triangular: the columns of
+                    // Q_1 up to the last active pair
+                    let p = self.active[na - 1] + 1;
+                    let mut h = Mat::<f64>::zeros(p, r);
+                    for (k, &i) in self.active.iter().enumerate() {
+                        for c in 0..r {
+                            h[(i, c)] = g[(k, c)];
+                        }
+                    }
+                    let mut y = Mat::<f64>::zeros(p, r);
+                    faer::linalg::matmul::triangular::matmul(
+                        y.as_mut(),
+                        faer::linalg::matmul::triangular::BlockStructure::Rectangular,
+                        Accum::Replace,
+                        r11.as_ref().submatrix(0, 0, p, p),
+                        faer::linalg::matmul::triangular::BlockStructure::TriangularUpper,
+                        h.as_ref(),
+                        faer::linalg::matmul::triangular::BlockStructure::Rectangular,
+                        1.0,
+                        Par::Seq,
+                    );
+                    matmul(
+                        f.as_mut(),
+                        Accum::Add,
+                        q.as_ref().subcols(0, p),
+                        y.as_ref(),
+                        -1.0,
+                        par,
+                    );
+                }
             }
         }
         for col in 0..r {
