@@ -199,9 +199,20 @@ pub fn peak_rss_mb() -> Option<f64> {
     Some(kb / 1024.0)
 }
 
+/// Returns the memory the allocator holds free to the system (glibc's `malloc_trim`:
+/// freed blocks inside its heaps otherwise stay resident, and a later stage whose blocks
+/// do not fit in them grows the heap beside them); nothing elsewhere.
+pub fn return_free_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only returns free pages of glibc's heaps to the system.
+    unsafe {
+        libc::malloc_trim(0);
+    }
+}
+
 /// Peak resident memory (MB) since the previous call (or the process's start), then the
-/// memory the allocator holds free returned to the system (glibc's `malloc_trim`: freed
-/// blocks inside its heaps stay resident otherwise) and the mark reset to the memory
+/// memory the allocator holds free returned to the system ([`return_free_memory`]) and
+/// the mark reset to the memory
 /// resident now (Linux: `VmHWM` of `/proc/self/status`, reset by writing `5` to
 /// `/proc/self/clear_refs`), so each stage of a run gets its own peak.
 /// After a call, [`peak_rss_mb`] gives the peak since that call, not the process's: a run
@@ -209,11 +220,7 @@ pub fn peak_rss_mb() -> Option<f64> {
 /// do not exist; when the reset is refused the peaks are cumulative (still upper bounds).
 pub fn take_peak_rss_mb() -> Option<f64> {
     let peak = peak_rss_mb()?;
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    // SAFETY: malloc_trim only returns free pages of glibc's heaps to the system.
-    unsafe {
-        libc::malloc_trim(0);
-    }
+    return_free_memory();
     let _ = std::fs::write("/proc/self/clear_refs", "5");
     Some(peak)
 }

@@ -433,6 +433,9 @@ fn references(
         .map_err(at())?;
         let (reference, _, _) = full.solve(&op, mu, true).map_err(at())?;
         let ref_time = t.elapsed().as_secs_f64();
+        // the next point's factorization starts from a heap without this one's pieces
+        drop(full);
+        crate::profile::return_free_memory();
         for (basis, modes_at) in kept {
             let modes = match modes_at.iter().find(|(m, _)| (m - mu).abs() < 1e-9) {
                 Some((_, m)) => m.clone(),
