@@ -212,9 +212,9 @@ pub fn return_free_memory() {
 
 /// Peak resident memory (MB) since the previous call (or the process's start), then the
 /// memory the allocator holds free returned to the system ([`return_free_memory`]) and
-/// the mark reset to the memory
-/// resident now (Linux: `VmHWM` of `/proc/self/status`, reset by writing `5` to
-/// `/proc/self/clear_refs`), so each stage of a run gets its own peak.
+/// the mark reset to the memory resident now (Linux: `VmHWM` of `/proc/self/status`,
+/// reset by writing `5` to `/proc/self/clear_refs`), so each stage of a run gets its own
+/// peak.
 /// After a call, [`peak_rss_mb`] gives the peak since that call, not the process's: a run
 /// that takes stage peaks reports the largest of them as its peak. `None` where the files
 /// do not exist; when the reset is refused the peaks are cumulative (still upper bounds).

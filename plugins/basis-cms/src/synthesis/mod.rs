@@ -104,8 +104,8 @@ pub const STORE_LIMIT_BYTES: usize = 3 << 30;
 
 /// Largest memory (bytes) of the stored static responses with their second-order terms
 /// (`32 n nR` bytes). Above it the second-order terms are solved per expansion (one block
-/// solve of the modes expanded): the default rig's 441 pairs would take 2.3 GiB, as much
-/// as the rest of its model.
+/// solve of the modes expanded): on the default rig's 441 pairs they would take 2.3 GiB,
+/// more than the model and its factor of `K` together (1.3 GB).
 pub const STORE_SECOND_LIMIT_BYTES: usize = 2 << 30;
 
 /// Largest memory (bytes) of the second-order gaps kept when the responses are not
