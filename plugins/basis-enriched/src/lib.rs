@@ -122,20 +122,15 @@ impl ReductionBasis for EnrichedBasis {
         let Some(pairs) = PairSolves::stage(free)? else {
             return Ok(None);
         };
-        let pairs = match Arc::downcast::<PairSolves>(pairs) {
+        let mut pairs = match Arc::downcast::<PairSolves>(pairs) {
             Ok(p) => p,
             Err(_) => return Err(Error::Invalid("enriched: pair solves expected".into())),
         };
         let space = StaticSpace::new(free, &pairs)?;
         // the space holds Z = K^-1 C^T in its basis: the pair solves give up their copy
-        let pairs = match (&space, Arc::try_unwrap(pairs)) {
-            (Some(sp), Ok(mut own)) => {
-                own.share_normals_with(sp)?;
-                Arc::new(own)
-            }
-            (_, Ok(own)) => Arc::new(own),
-            (_, Err(shared)) => shared,
-        };
+        if let (Some(sp), Some(own)) = (&space, Arc::get_mut(&mut pairs)) {
+            own.share_normals_with(sp)?;
+        }
         Ok(Some(Arc::new(EnrichedStage { pairs, space })))
     }
 
