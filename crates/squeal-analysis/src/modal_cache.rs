@@ -12,15 +12,20 @@
 //! and the bits of their values, through a 64-bit fingerprint) and every eigen parameter
 //! are the same; the answer is then the one the solver gave the first time. The cache
 //! holds at most [`ModalCache::budget_bytes`] of mode shapes and drops the oldest entries
-//! beyond that. Complex (frictional) solves are passed through unchanged.
+//! beyond that. A cache made by [`ModalCache::spilling`] keeps only the newest of them in
+//! memory and the older ones in files of a folder of its own (the shapes' bits, read back
+//! when asked for). Complex (frictional) solves are passed through unchanged.
 
 use squeal_core::eigen::SymmetricProblem;
+use squeal_core::faer::Mat;
 use squeal_core::faer::MatRef;
 use squeal_core::operator::RealModes;
 use squeal_core::operator::{ComplexModes, Qep};
 use squeal_core::spectral::ShiftInvert;
 use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Result, SparseRef};
 use std::collections::VecDeque;
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
@@ -78,8 +83,40 @@ impl Fingerprint {
 
 struct Entry {
     key: Key,
-    modes: Arc<RealModes>,
+    modes: Kept,
     bytes: usize,
+}
+
+impl Entry {
+    /// Drops the entry and its file, if it has one.
+    fn forget(self) {
+        if let Kept::File { path, .. } = self.modes {
+            let _ = std::fs::remove_file(path);
+        }
+    }
+}
+
+/// Where an entry's modes are.
+enum Kept {
+    /// In memory.
+    Memory(Arc<RealModes>),
+    /// The shapes (`vectors`, then `above_band`, column by column, the bits of each
+    /// value) in `path`; `head` holds the rest, its shapes `n x 0`.
+    File {
+        path: PathBuf,
+        head: Box<RealModes>,
+        vectors: usize,
+        above_band: usize,
+    },
+}
+
+/// The folder of a spilling cache's files (made at the first spill, removed with the
+/// cache) and how many bytes of shapes stay in memory.
+struct Spill {
+    parent: PathBuf,
+    dir: Option<tempfile::TempDir>,
+    memory_bytes: usize,
+    written: usize,
 }
 
 /// Real modes of earlier solves, shared by every method of a run (see the module docs).
@@ -87,6 +124,7 @@ pub struct ModalCache {
     /// Most bytes of mode shapes kept; older entries are dropped beyond it.
     pub budget_bytes: usize,
     entries: Mutex<VecDeque<Entry>>,
+    spill: Option<Mutex<Spill>>,
     hits: AtomicUsize,
 }
 
@@ -97,13 +135,39 @@ impl Default for ModalCache {
 }
 
 impl ModalCache {
-    /// An empty cache that keeps at most `budget_bytes` of mode shapes.
+    /// An empty cache that keeps at most `budget_bytes` of mode shapes, in memory.
     pub fn new(budget_bytes: usize) -> Self {
         Self {
             budget_bytes,
             entries: Mutex::new(VecDeque::new()),
+            spill: None,
             hits: AtomicUsize::new(0),
         }
+    }
+
+    /// An empty cache that keeps at most `budget_bytes` of mode shapes, of which the
+    /// newest `memory_bytes` in memory and the older ones in files of a folder it makes
+    /// in `parent` (at its first spill; removed with the cache). A file that cannot be
+    /// written or read back loses its entry, which is then solved again.
+    pub fn spilling(budget_bytes: usize, memory_bytes: usize, parent: &Path) -> Self {
+        Self {
+            spill: Some(Mutex::new(Spill {
+                parent: parent.to_path_buf(),
+                dir: None,
+                memory_bytes,
+                written: 0,
+            })),
+            ..Self::new(budget_bytes)
+        }
+    }
+
+    /// How many kept solves have their shapes in files.
+    pub fn spilled(&self) -> usize {
+        let entries = self.entries.lock().unwrap_or_else(|p| p.into_inner());
+        entries
+            .iter()
+            .filter(|e| matches!(e.modes, Kept::File { .. }))
+            .count()
     }
 
     /// How many requests were served from the cache.
@@ -123,20 +187,32 @@ impl ModalCache {
 
     /// Drops every kept solve (the hit count stays).
     pub fn clear(&self) {
-        self.entries
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .clear();
+        let mut entries = self.entries.lock().unwrap_or_else(|p| p.into_inner());
+        entries.drain(..).for_each(Entry::forget);
     }
 
     fn get(&self, key: &Key) -> Option<Arc<RealModes>> {
-        let entries = self.entries.lock().unwrap_or_else(|p| p.into_inner());
-        let found = entries
-            .iter()
-            .find(|e| &e.key == key)
-            .map(|e| e.modes.clone());
-        if found.is_some() {
-            self.hits.fetch_add(1, Ordering::Relaxed);
+        let mut entries = self.entries.lock().unwrap_or_else(|p| p.into_inner());
+        let i = entries.iter().position(|e| &e.key == key)?;
+        let found = match &entries[i].modes {
+            Kept::Memory(modes) => Some(modes.clone()),
+            Kept::File {
+                path,
+                head,
+                vectors,
+                above_band,
+            } => read_shapes(path, head, *vectors, *above_band).map(Arc::new),
+        };
+        match found {
+            Some(_) => {
+                self.hits.fetch_add(1, Ordering::Relaxed);
+            }
+            // its file is gone or damaged: the entry is forgotten
+            None => {
+                if let Some(e) = entries.remove(i) {
+                    e.forget();
+                }
+            }
         }
         found
     }
@@ -154,11 +230,131 @@ impl ModalCache {
         let mut total: usize = entries.iter().map(|e| e.bytes).sum::<usize>() + bytes;
         while total > self.budget_bytes {
             match entries.pop_front() {
-                Some(old) => total -= old.bytes,
+                Some(old) => {
+                    total -= old.bytes;
+                    old.forget();
+                }
                 None => break,
             }
         }
-        entries.push_back(Entry { key, modes, bytes });
+        entries.push_back(Entry {
+            key,
+            modes: Kept::Memory(modes),
+            bytes,
+        });
+        if let Some(spill) = &self.spill {
+            let mut spill = spill.lock().unwrap_or_else(|p| p.into_inner());
+            spill.move_out(&mut entries);
+        }
+    }
+}
+
+impl Spill {
+    /// Writes the oldest entries kept in memory to files until the newest ones alone
+    /// fit [`Spill::memory_bytes`]; an entry whose file cannot be written is dropped.
+    fn move_out(&mut self, entries: &mut VecDeque<Entry>) {
+        let in_memory = |entries: &VecDeque<Entry>| -> usize {
+            entries
+                .iter()
+                .filter(|e| matches!(e.modes, Kept::Memory(_)))
+                .map(|e| e.bytes)
+                .sum()
+        };
+        while in_memory(entries) > self.memory_bytes {
+            let Some(i) = entries
+                .iter()
+                .position(|e| matches!(e.modes, Kept::Memory(_)))
+            else {
+                break;
+            };
+            let Kept::Memory(modes) = &entries[i].modes else {
+                unreachable!("found in memory above")
+            };
+            match self.write(modes) {
+                Some(kept) => entries[i].modes = kept,
+                None => {
+                    entries.remove(i);
+                }
+            }
+        }
+    }
+
+    /// The shapes of `modes` in a new file of the folder.
+    fn write(&mut self, modes: &RealModes) -> Option<Kept> {
+        if self.dir.is_none() {
+            self.dir = tempfile::Builder::new()
+                .prefix(".squeal-modal-cache-")
+                .tempdir_in(&self.parent)
+                .ok();
+        }
+        let path = self
+            .dir
+            .as_ref()?
+            .path()
+            .join(format!("modes-{}.f64", self.written));
+        self.written += 1;
+        let file = std::fs::File::create(&path).ok()?;
+        let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
+        for m in [&modes.vectors, &modes.above_band] {
+            for c in 0..m.ncols() {
+                for v in m.col(c).iter() {
+                    out.write_all(&v.to_bits().to_le_bytes()).ok()?;
+                }
+            }
+        }
+        out.flush().ok()?;
+        let head = Box::new(with_shapes(
+            modes,
+            Mat::zeros(modes.vectors.nrows(), 0),
+            Mat::zeros(modes.above_band.nrows(), 0),
+        ));
+        Some(Kept::File {
+            path,
+            head,
+            vectors: modes.vectors.ncols(),
+            above_band: modes.above_band.ncols(),
+        })
+    }
+}
+
+/// The modes of a spilled entry: `head` with its shapes read back from `path`; `None`
+/// when the file is missing or not of the expected size.
+fn read_shapes(
+    path: &Path,
+    head: &RealModes,
+    vectors: usize,
+    above_band: usize,
+) -> Option<RealModes> {
+    let mut file = std::io::BufReader::with_capacity(1 << 20, std::fs::File::open(path).ok()?);
+    let mut read = |n: usize, k: usize| -> Option<Mat<f64>> {
+        let mut m = Mat::<f64>::zeros(n, k);
+        let mut word = [0u8; 8];
+        for c in 0..k {
+            for v in m.col_mut(c).iter_mut() {
+                file.read_exact(&mut word).ok()?;
+                *v = f64::from_bits(u64::from_le_bytes(word));
+            }
+        }
+        Some(m)
+    };
+    let v = read(head.vectors.nrows(), vectors)?;
+    let a = read(head.above_band.nrows(), above_band)?;
+    let mut rest = [0u8; 1];
+    if file.read(&mut rest).ok()? != 0 {
+        return None;
+    }
+    Some(with_shapes(head, v, a))
+}
+
+/// `modes` with the shapes `vectors` and `above_band` in place of its own.
+fn with_shapes(modes: &RealModes, vectors: Mat<f64>, above_band: Mat<f64>) -> RealModes {
+    RealModes {
+        omega2: modes.omega2.clone(),
+        freq_hz: modes.freq_hz.clone(),
+        vectors,
+        residuals: modes.residuals.clone(),
+        info: modes.info.clone(),
+        above_band,
     }
 }
 
@@ -343,6 +539,91 @@ mod tests {
         solver.solve_symmetric(&p, &params(3)).unwrap();
         assert_eq!(calls.load(Ordering::SeqCst), 3);
         assert_eq!(cache.len(), 3);
+    }
+
+    /// Files of the spill folder under `parent`.
+    fn spill_files(parent: &Path) -> Vec<PathBuf> {
+        let mut files = Vec::new();
+        for dir in std::fs::read_dir(parent).unwrap() {
+            let dir = dir.unwrap().path();
+            if dir.is_dir() {
+                for f in std::fs::read_dir(&dir).unwrap() {
+                    files.push(f.unwrap().path());
+                }
+            }
+        }
+        files
+    }
+
+    #[test]
+    fn a_spilling_cache_serves_the_same_bits_from_its_files_and_removes_them() {
+        let parent = tempfile::tempdir().unwrap();
+        let calls = Arc::new(AtomicUsize::new(0));
+        // room for both 3 x 2 blocks of shapes, none of it in memory
+        let cache = Arc::new(ModalCache::spilling(1000, 0, parent.path()));
+        let solver = CachedModal::new(Arc::new(Counting(calls.clone())), cache.clone());
+        let m = diagonal(&[1.0, 1.0, 1.0]);
+        let ks = [diagonal(&[4.0, 9.0, 16.0]), diagonal(&[4.0, 9.0, 25.0])];
+        fn pencil<'a>(k: &'a SparseMat, m: &'a SparseMat) -> SymmetricProblem<'a> {
+            SymmetricProblem {
+                k: k.as_ref(),
+                m: m.as_ref(),
+            }
+        }
+        let problem = |k| pencil(k, &m);
+        let first: Vec<RealModes> = ks
+            .iter()
+            .map(|k| solver.solve_symmetric(&problem(k), &params(2)).unwrap())
+            .collect();
+        assert_eq!(cache.spilled(), 2);
+        assert_eq!(spill_files(parent.path()).len(), 2);
+        for (k, f) in ks.iter().zip(&first) {
+            let again = solver.solve_symmetric(&problem(k), &params(2)).unwrap();
+            assert_eq!(again.omega2, f.omega2);
+            assert_eq!(again.vectors, f.vectors);
+            assert_eq!(again.above_band.ncols(), 0);
+        }
+        assert_eq!((calls.load(Ordering::SeqCst), cache.hits()), (2, 2));
+        // shapes whose bits a decimal round trip would not keep, read back bit for bit
+        let values = [1.0 / 3.0, -0.0, 1e-310, f64::NAN, -2.5e17, f64::INFINITY];
+        let odd = RealModes {
+            vectors: Mat::from_fn(3, 2, |i, j| values[i + 3 * j]),
+            above_band: Mat::from_fn(3, 1, |i, _| values[5 - i]),
+            ..first[0].clone()
+        };
+        let key = Key {
+            solver: "odd".into(),
+            k: Fingerprint::of(ks[0].as_ref()),
+            m: Fingerprint::of(m.as_ref()),
+            params: params(2),
+        };
+        cache.put(key.clone(), Arc::new(odd.clone()));
+        assert_eq!(cache.spilled(), 3);
+        let back = cache.get(&key).unwrap();
+        let bits = |a: &Mat<f64>| -> Vec<u64> {
+            (0..a.ncols())
+                .flat_map(|c| a.col(c).iter().map(|v| v.to_bits()).collect::<Vec<_>>())
+                .collect()
+        };
+        assert_eq!(bits(&back.vectors), bits(&odd.vectors));
+        assert_eq!(bits(&back.above_band), bits(&odd.above_band));
+        cache.clear();
+        assert_eq!(cache.hits(), 3);
+        // a file gone: its entry is forgotten and solved again
+        for k in &ks {
+            solver.solve_symmetric(&problem(k), &params(2)).unwrap();
+        }
+        assert_eq!(calls.load(Ordering::SeqCst), 4);
+        std::fs::remove_file(&spill_files(parent.path())[0]).unwrap();
+        for k in &ks {
+            solver.solve_symmetric(&problem(k), &params(2)).unwrap();
+        }
+        assert_eq!(calls.load(Ordering::SeqCst), 5);
+        assert_eq!(cache.len(), 2);
+        cache.clear();
+        assert!(spill_files(parent.path()).is_empty());
+        drop((solver, cache));
+        assert_eq!(std::fs::read_dir(parent.path()).unwrap().count(), 0);
     }
 
     #[test]

@@ -253,6 +253,21 @@ impl Prepared {
         self.modal_cache.clear();
     }
 
+    /// This model with `cache` for the real modes of its tied systems in place of its own
+    /// (e.g. a cache that keeps them in files, [`ModalCache::spilling`]).
+    pub fn with_modal_cache(mut self, cache: ModalCache) -> Self {
+        self.modal_cache = Arc::new(cache);
+        self
+    }
+
+    /// The model, its candidate pairs and the scene's damping, everything else dropped
+    /// (the condensation's factor of `K`, the kept modes and model stages): what the
+    /// frictional operators of known active sets ([`damped_operator`]) need, for a stage
+    /// that solves no more equilibria.
+    pub fn into_model(self) -> (Model, ContactSet, Damping) {
+        (self.model, self.set, self.scene.damping)
+    }
+
     /// The real modes of the tied systems solved on this model so far, for
     /// [`Method::share_modal_cache`].
     pub fn modal_cache(&self) -> Arc<ModalCache> {

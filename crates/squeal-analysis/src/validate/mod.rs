@@ -16,11 +16,12 @@
 use crate::bench::{compare, ModeErrors};
 use crate::equilibria::EquilibriumReport;
 use crate::modal::{BodyModes, ModeRecord, TableRow};
+use crate::modal_cache::{ModalCache, DEFAULT_BUDGET_BYTES};
 use crate::mu_sweep::{
     matching_coupling, mu_list, run_into, MuSweep, MuSweepSettings, SweepEvent, SweepSummary,
 };
 use crate::outdir::{self, RunError};
-use crate::pipeline::{Method, Prepared, MODAL_SOLVER};
+use crate::pipeline::{damped_operator, Method, Prepared, MODAL_SOLVER};
 use crate::profile::{max_opt, peak_rss_mb, take_peak_rss_mb, Machine, Profile};
 use crate::reference::paper;
 use serde::Serialize;
@@ -242,7 +243,10 @@ pub fn run(
         .into_iter()
         .filter(|m| m.freq_hz < PIN_MODES_TOP_HZ)
         .collect();
-    let prep = Prepared::new(registry, scene.clone(), file)?;
+    // the check sweeps' tied real modes, solved by one and read by the other, wait in
+    // files of the report directory rather than in memory
+    let modal_cache = ModalCache::spilling(DEFAULT_BUDGET_BYTES, 0, out);
+    let prep = Prepared::new(registry, scene.clone(), file)?.with_modal_cache(modal_cache);
     let eq0 = prep
         .equilibrium(registry, "lcp", "lagrange", 0.0)
         .map_err(outdir::stage("the rig's stiffness (equilibrium at mu = 0)"))?;
@@ -303,7 +307,7 @@ pub fn run(
     // stages, free modes, the tied systems' real modes)
     hooks.stage(5, n, "full-order reference points");
     prep.release_kept();
-    let references = references(registry, &prep, s, band, &kept)?;
+    let references = references(registry, prep, s, band, &kept)?;
     stage("full-order references", &mut lap);
 
     // 6. report
@@ -373,7 +377,14 @@ fn run_sweep(
         &dir,
         true,
         &Profile::new(),
-        |e| hooks.sweep_event(&dir, prep, e),
+        |e| {
+            // each point's blocks go back to the system as it ends: freed pieces of many
+            // sizes would otherwise stay resident between the next point's blocks
+            if matches!(e, SweepEvent::Point(_)) {
+                crate::profile::return_free_memory();
+            }
+            hooks.sweep_event(&dir, prep, e)
+        },
     )?;
     hooks.sweep_done(&dir, &summary, &sweep)?;
     Ok((summary, sweep))
@@ -400,10 +411,13 @@ fn paper_rows_of(basis: &str, step: f64, summary: &SweepSummary) -> Vec<PaperRow
         .collect()
 }
 
-/// Full-order solves at the reference mu, and every swept basis against them.
+/// Full-order solves at the reference mu, and every swept basis against them. The
+/// equilibria (and the basis solves a resumed sweep did not keep) come first, on the
+/// whole prepared model; the full-order solves then run on the model and its contact set
+/// alone, without the condensation's factor of `K`.
 fn references(
     registry: &Registry,
-    prep: &Prepared,
+    prep: Prepared,
     s: &ValidateSettings,
     band: [f64; 2],
     kept: &[(String, Vec<(f64, squeal_core::operator::ComplexModes)>)],
@@ -414,13 +428,45 @@ fn references(
         tol: 1e-10,
         ..EigenParams::default()
     };
-    let mut refs = Vec::new();
+    let at = |mu: f64| outdir::stage(format!("full-order reference at mu = {mu}"));
+    // each point's active set and the modes of every basis there
+    let mut points = Vec::new();
     for &mu in &s.reference_mu {
-        let at = || outdir::stage(format!("full-order reference at mu = {mu}"));
-        let eq = prep
+        let active = prep
             .equilibrium(registry, "lcp", "lagrange", mu)
-            .map_err(at())?;
-        let op = prep.operator(&eq.eq.active).map_err(at())?;
+            .map_err(at(mu))?
+            .eq
+            .active;
+        let mut modes = Vec::new();
+        for (basis, modes_at) in kept {
+            let found = modes_at.iter().find(|(m, _)| (m - mu).abs() < 1e-9);
+            modes.push(match found {
+                Some((_, m)) => m.clone(),
+                // a resumed sweep computed this point in an earlier run: solve it again
+                None => {
+                    let op = prep.operator(&active).map_err(at(mu))?;
+                    let mut method = Method::new(
+                        registry,
+                        basis,
+                        &Params::new(),
+                        "dense",
+                        MODAL_SOLVER,
+                        params.clone(),
+                    )
+                    .map_err(at(mu))?;
+                    method.prepare_stage_on(&prep).map_err(at(mu))?;
+                    method.share_modal_cache(prep.modal_cache());
+                    method.solve(&op, mu, true).map_err(at(mu))?.0
+                }
+            });
+        }
+        points.push((mu, active, modes));
+    }
+    let (model, set, damping) = prep.into_model();
+    crate::profile::return_free_memory();
+    let mut refs = Vec::new();
+    for (mu, active, modes) in points {
+        let op = damped_operator(&model, &damping, &set, &active).map_err(at(mu))?;
         let t = Instant::now();
         let mut full = Method::new(
             registry,
@@ -430,35 +476,17 @@ fn references(
             MODAL_SOLVER,
             params.clone(),
         )
-        .map_err(at())?;
-        let (reference, _, _) = full.solve(&op, mu, true).map_err(at())?;
+        .map_err(at(mu))?;
+        let (reference, _, _) = full.solve(&op, mu, true).map_err(at(mu))?;
         let ref_time = t.elapsed().as_secs_f64();
         // the next point's factorization starts from a heap without this one's pieces
-        drop(full);
+        drop((full, op));
         crate::profile::return_free_memory();
-        for (basis, modes_at) in kept {
-            let modes = match modes_at.iter().find(|(m, _)| (m - mu).abs() < 1e-9) {
-                Some((_, m)) => m.clone(),
-                // a resumed sweep computed this point in an earlier run: solve it again
-                None => {
-                    let mut method = Method::new(
-                        registry,
-                        basis,
-                        &Params::new(),
-                        "dense",
-                        MODAL_SOLVER,
-                        params.clone(),
-                    )
-                    .map_err(at())?;
-                    method.prepare_stage_on(prep).map_err(at())?;
-                    method.share_modal_cache(prep.modal_cache());
-                    method.solve(&op, mu, true).map_err(at())?.0
-                }
-            };
+        for ((basis, _), modes) in kept.iter().zip(&modes) {
             refs.push(RefRow {
                 mu,
                 basis: basis.clone(),
-                errors: compare(&reference, &modes, band, 1e-6),
+                errors: compare(&reference, modes, band, 1e-6),
                 reference_time_s: ref_time,
             });
         }
