@@ -35,6 +35,9 @@ use std::sync::{Arc, Mutex};
 /// goes first, so a sweep one set larger than the budget would find none).
 pub const DEFAULT_BUDGET_BYTES: usize = 512 << 20;
 
+/// Name prefix of the folder a spilling cache makes ([`ModalCache::spilling`]).
+pub const SPILL_PREFIX: &str = ".squeal-modal-cache-";
+
 /// What identifies a symmetric solve.
 #[derive(Debug, Clone, PartialEq)]
 struct Key {
@@ -161,6 +164,20 @@ impl ModalCache {
         }
     }
 
+    /// Removes the folders that spilling caches made in `parent` and left there (their
+    /// process stopped before dropping them); errors are ignored.
+    pub fn remove_spill_folders(parent: &Path) {
+        let Ok(entries) = std::fs::read_dir(parent) else {
+            return;
+        };
+        for e in entries.flatten() {
+            let ours = e.file_name().to_string_lossy().starts_with(SPILL_PREFIX);
+            if ours && e.path().is_dir() {
+                let _ = std::fs::remove_dir_all(e.path());
+            }
+        }
+    }
+
     /// How many kept solves have their shapes in files.
     pub fn spilled(&self) -> usize {
         let entries = self.entries.lock().unwrap_or_else(|p| p.into_inner());
@@ -283,7 +300,7 @@ impl Spill {
     fn write(&mut self, modes: &RealModes) -> Option<Kept> {
         if self.dir.is_none() {
             self.dir = tempfile::Builder::new()
-                .prefix(".squeal-modal-cache-")
+                .prefix(SPILL_PREFIX)
                 .tempdir_in(&self.parent)
                 .ok();
         }
@@ -624,6 +641,14 @@ mod tests {
         assert!(spill_files(parent.path()).is_empty());
         drop((solver, cache));
         assert_eq!(std::fs::read_dir(parent.path()).unwrap().count(), 0);
+        // a folder left by a stopped run goes, other files stay
+        let left = parent.path().join(format!("{SPILL_PREFIX}abc"));
+        std::fs::create_dir(&left).unwrap();
+        std::fs::write(left.join("modes-0.f64"), [0u8; 8]).unwrap();
+        std::fs::write(parent.path().join("report.md"), "kept").unwrap();
+        ModalCache::remove_spill_folders(parent.path());
+        assert!(!left.exists());
+        assert!(parent.path().join("report.md").exists());
     }
 
     #[test]

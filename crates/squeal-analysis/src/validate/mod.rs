@@ -244,7 +244,9 @@ pub fn run(
         .filter(|m| m.freq_hz < PIN_MODES_TOP_HZ)
         .collect();
     // the check sweeps' tied real modes, solved by one and read by the other, wait in
-    // files of the report directory rather than in memory
+    // files of the report directory rather than in memory (a run stopped before its end
+    // left its files there)
+    ModalCache::remove_spill_folders(out);
     let modal_cache = ModalCache::spilling(DEFAULT_BUDGET_BYTES, 0, out);
     let prep = Prepared::new(registry, scene.clone(), file)?.with_modal_cache(modal_cache);
     let eq0 = prep
