@@ -278,16 +278,17 @@ impl Spill {
                 .sum()
         };
         while in_memory(entries) > self.memory_bytes {
-            let Some(i) = entries
+            let oldest = entries
                 .iter()
-                .position(|e| matches!(e.modes, Kept::Memory(_)))
-            else {
+                .enumerate()
+                .find_map(|(i, e)| match &e.modes {
+                    Kept::Memory(modes) => Some((i, modes.clone())),
+                    Kept::File { .. } => None,
+                });
+            let Some((i, modes)) = oldest else {
                 break;
             };
-            let Kept::Memory(modes) = &entries[i].modes else {
-                unreachable!("found in memory above")
-            };
-            match self.write(modes) {
+            match self.write(&modes) {
                 Some(kept) => entries[i].modes = kept,
                 None => {
                     entries.remove(i);
@@ -310,16 +311,23 @@ impl Spill {
             .path()
             .join(format!("modes-{}.f64", self.written));
         self.written += 1;
-        let file = std::fs::File::create(&path).ok()?;
-        let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
-        for m in [&modes.vectors, &modes.above_band] {
-            for c in 0..m.ncols() {
-                for v in m.col(c).iter() {
-                    out.write_all(&v.to_bits().to_le_bytes()).ok()?;
+        let written = (|| -> std::io::Result<()> {
+            let file = std::fs::File::create(&path)?;
+            let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
+            for m in [&modes.vectors, &modes.above_band] {
+                for c in 0..m.ncols() {
+                    for v in m.col(c).iter() {
+                        out.write_all(&v.to_bits().to_le_bytes())?;
+                    }
                 }
             }
+            out.flush()
+        })();
+        if written.is_err() {
+            // a partly written file (a full disk) is not left behind
+            let _ = std::fs::remove_file(&path);
+            return None;
         }
-        out.flush().ok()?;
         let head = Box::new(with_shapes(
             modes,
             Mat::zeros(modes.vectors.nrows(), 0),
@@ -641,6 +649,15 @@ mod tests {
         assert!(spill_files(parent.path()).is_empty());
         drop((solver, cache));
         assert_eq!(std::fs::read_dir(parent.path()).unwrap().count(), 0);
+        // room in memory for one entry: the older one goes to a file
+        let cache = Arc::new(ModalCache::spilling(1000, 60, parent.path()));
+        let solver = CachedModal::new(Arc::new(Counting(calls.clone())), cache.clone());
+        for k in &ks {
+            solver.solve_symmetric(&problem(k), &params(2)).unwrap();
+        }
+        assert_eq!((cache.len(), cache.spilled()), (2, 1));
+        assert_eq!(spill_files(parent.path()).len(), 1);
+        drop((solver, cache));
         // a folder left by a stopped run goes, other files stay
         let left = parent.path().join(format!("{SPILL_PREFIX}abc"));
         std::fs::create_dir(&left).unwrap();

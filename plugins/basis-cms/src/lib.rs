@@ -47,6 +47,7 @@ use squeal_core::{
     Basis, BasisRequest, Error, FreeModel, ModelStage, Params, ReductionBasis, Registry, Result,
 };
 use std::sync::Arc;
+use std::time::Instant;
 
 pub mod synthesis;
 
@@ -197,7 +198,9 @@ impl ReductionBasis for CmsBasis {
             })?;
         let op = request.op;
         let active = free.active_in(op)?;
+        let clock = Instant::now();
         let syn = free.synthesize(&active, request.mu)?;
+        let t_synthesis = clock.elapsed().as_secs_f64();
         let cutoff = self.cutoff_factor * request.band_hz.1;
         // one member of each conjugate pair of s (their expansions are conjugate)
         let which: Vec<usize> = (0..syn.s.len())
@@ -210,10 +213,16 @@ impl ReductionBasis for CmsBasis {
         }
         if self.on_pairs && op.cc.is_none() && free.has_pair_moments() {
             let t = op.t.as_ref().expect("checked by active_in");
+            let clock = Instant::now();
             let p = free.project_on_pairs(&syn, &which, self.second_order, t, op.dim())?;
+            let t_pairs = clock.elapsed().as_secs_f64();
             let m = p.reduced.dim();
             let mut basis = Basis::implicit(Arc::new(p.columns), p.reduced);
             basis.dropped = p.dropped;
+            basis.steps = vec![
+                ("synthesis".into(), t_synthesis),
+                ("projection on the pairs".into(), t_pairs),
+            ];
             basis.notes.push(format!(
                 "{NAME}: {} synthesized modes up to {cutoff:.1} Hz from {} free-interface \
                  modes (to {:.1} Hz) and {} tied pairs of {} candidates, {m} vectors ({} \
@@ -230,6 +239,7 @@ impl ReductionBasis for CmsBasis {
         }
         // the expanded modes (and their second-order directions), real and imaginary
         // parts side by side
+        let clock = Instant::now();
         let blocks = if self.second_order {
             let (u, w) = free.expand_parts_with_correction(&syn, &which)?;
             vec![u, w]
@@ -239,9 +249,16 @@ impl ReductionBasis for CmsBasis {
         let t = op.t.as_ref().expect("checked by active_in");
         let raw = constrained_columns(&blocks, which.len(), t, op.dim());
         drop(blocks);
+        let t_expansion = clock.elapsed().as_secs_f64();
+        let clock = Instant::now();
         let (v, dropped) = m_orthonormalize(op.mc.as_ref(), raw.as_ref(), self.rank_tol)?;
         let mut basis = Basis::new(v);
         basis.dropped = dropped;
+        basis.steps = vec![
+            ("synthesis".into(), t_synthesis),
+            ("expansion".into(), t_expansion),
+            ("orthonormalization".into(), clock.elapsed().as_secs_f64()),
+        ];
         basis.notes.push(format!(
             "{NAME}: {} synthesized modes up to {cutoff:.1} Hz from {} free-interface modes \
              (to {:.1} Hz) and {} tied pairs of {} candidates, {} vectors ({dropped} removed \

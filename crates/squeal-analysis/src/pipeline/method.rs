@@ -91,6 +91,8 @@ pub struct Method {
     stage: Option<ModelStage>,
     condition: bool,
     last: StepTimes,
+    /// The steps of the last basis built ([`squeal_core::Basis::steps`]).
+    last_steps: Vec<(String, f64)>,
     /// Whether a basis starts from the seed its build at the previous point left
     /// ([`Method::set_warm_start`]).
     warm_start: bool,
@@ -150,6 +152,7 @@ impl Method {
             stage: None,
             condition: false,
             last: StepTimes::default(),
+            last_steps: Vec::new(),
             warm_start: false,
             seed: squeal_core::Seed::default(),
         })
@@ -243,10 +246,18 @@ impl Method {
         self.last
     }
 
+    /// The steps of the basis the last [`solve`](Self::solve) built, with their times
+    /// (s; [`squeal_core::Basis::steps`]); empty when it built none or its basis does not
+    /// time its steps.
+    pub fn last_basis_steps(&self) -> &[(String, f64)] {
+        &self.last_steps
+    }
+
     /// The modes of `op` at `mu`; `rebuilt` says the operator changed since the last call
     /// (a new contact set), which invalidates a cached basis. Returns the modes, the basis
     /// size (0 for full order) and the time spent on the basis and projection (s).
     pub fn solve(&mut self, op: &FrictionalOperator, mu: f64, rebuilt: bool) -> Result<StepResult> {
+        self.last_steps.clear();
         let Some(basis) = &self.basis else {
             let mut modes = self
                 .eigen
@@ -289,6 +300,7 @@ impl Method {
             let mut b = squeal_core::contact::build_basis(basis.as_ref(), &req)
                 .map_err(core(&format!("basis `{}` at mu = {mu}", self.basis_name)))?;
             let seed = std::mem::take(&mut b.seed);
+            self.last_steps = std::mem::take(&mut b.steps);
             if self.warm_start {
                 self.seed = seed;
             }

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use squeal_contact::ContactSet;
 use squeal_core::Registry;
 use squeal_scene::{Damping, Model};
+use std::collections::BTreeMap;
 use std::sync::Mutex;
 use std::time::Instant;
 
@@ -83,6 +84,10 @@ pub struct Timing {
     pub expansion_s: f64,
     /// The whole case.
     pub total_s: f64,
+    /// The basis's steps (s, by step; [`squeal_core::Basis::steps`]), for a basis that
+    /// times them.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub basis_steps: BTreeMap<String, f64>,
 }
 
 /// Solves one case on `model` with `method`.
@@ -118,6 +123,9 @@ pub fn run_case(
         let st = method.last_times();
         (t.basis_s, t.projection_s, t.solve_s, t.expansion_s) =
             (st.basis_s, st.projection_s, st.solve_s, st.expansion_s);
+        for (step, s) in method.last_basis_steps() {
+            *t.basis_steps.entry(step.clone()).or_insert(0.0) += s;
+        }
         rec.basis_size = basis_size;
         let mut idx: Vec<usize> = (0..modes.len()).collect();
         idx.sort_by(|&a, &b| modes.freq_hz[a].total_cmp(&modes.freq_hz[b]));
@@ -286,6 +294,9 @@ pub fn run(
             ("expansion + backward errors", t.expansion_s),
         ] {
             profile.add(stage, s);
+        }
+        for (step, s) in &t.basis_steps {
+            profile.add(&format!("basis: {step}"), *s);
         }
     }
     let (summary, tsum) = finalize(dir, def, &list, records, timings)?;

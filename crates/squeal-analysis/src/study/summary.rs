@@ -337,6 +337,9 @@ impl TimingSummary {
             total.solve_s += t.solve_s;
             total.expansion_s += t.expansion_s;
             total.total_s += t.total_s;
+            for (step, s) in &t.basis_steps {
+                *total.basis_steps.entry(step.clone()).or_insert(0.0) += s;
+            }
         }
         let n = timings.len().max(1) as f64;
         let mean = Timing {
@@ -348,6 +351,11 @@ impl TimingSummary {
             solve_s: total.solve_s / n,
             expansion_s: total.expansion_s / n,
             total_s: total.total_s / n,
+            basis_steps: total
+                .basis_steps
+                .iter()
+                .map(|(step, s)| (step.clone(), s / n))
+                .collect(),
         };
         Self {
             cases: timings.len(),

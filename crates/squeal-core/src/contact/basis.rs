@@ -45,6 +45,9 @@ pub struct Basis {
     pub residual: Option<f64>,
     /// Anything the user should know (what the columns are, non-convergence, ...).
     pub notes: Vec<String>,
+    /// Where the build's time went, step by step (`(step, s)`), for a basis that times
+    /// its steps; empty otherwise. Reports list them under the basis's time.
+    pub steps: Vec<(String, f64)>,
     /// The operator projected on exactly these columns, when the basis computed it while
     /// building (an iterative basis projects at every step): the projection stage takes
     /// it instead of projecting again. `None`: projected after the build.
@@ -90,6 +93,7 @@ impl Basis {
             mu: None,
             residual: None,
             notes: Vec::new(),
+            steps: Vec::new(),
             projected: None,
             seed: Seed::default(),
         }
