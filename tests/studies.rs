@@ -416,35 +416,21 @@ fn a_meso_study_resumed_with_more_layouts_equals_one_run_with_them() {
 }
 
 #[test]
-fn a_study_through_cms_times_the_steps_of_its_basis() {
+fn a_study_lists_the_timed_steps_of_its_basis() {
     let f = fixture();
-    let mut def = meso_def(&f);
-    def.solve.basis = "cms".into();
-    let dir = tmp("steps");
-    let r = run(&f, &def, &dir, RunOptions::default());
-    assert_eq!((r.computed, r.summary.failed), (6, 0));
-    let steps = ["expansion", "orthonormalization", "synthesis"];
-    let timings = StudyDir::new(&dir).timing_records().unwrap();
-    assert_eq!(timings.len(), 6);
-    for t in &timings {
-        let keys: Vec<&str> = t.basis_steps.keys().map(String::as_str).collect();
-        assert_eq!(keys, steps, "case {}", t.id);
-        let sum: f64 = t.basis_steps.values().sum();
-        assert!(t.basis_steps.values().all(|s| s.is_finite() && *s >= 0.0));
-        // the steps are parts of the basis's time
-        assert!(sum <= t.basis_s * (1.0 + 1e-9), "case {}: {t:?}", t.id);
-    }
-    for step in steps {
-        let total: f64 = timings.iter().map(|t| t.basis_steps[step]).sum();
-        let row = r
-            .profile
-            .stages
-            .iter()
-            .find(|s| s.stage == format!("basis: {step}"))
-            .unwrap_or_else(|| panic!("no profile row for {step}"));
-        assert!((row.time_s - total).abs() <= 1e-9 * total.max(1.0));
-        assert_eq!(row.count, 6);
-        assert!((r.timings.mean.basis_steps[step] - total / 6.0).abs() <= 1e-9 * total.max(1.0));
+    for (basis, steps) in [
+        ("cms", vec!["expansion", "orthonormalization", "synthesis"]),
+        (
+            "enriched",
+            vec![
+                "real modes",
+                "set-up",
+                "statics, orthonormalization and projection",
+            ],
+        ),
+        ("residue", vec!["iterations", "real modes", "set-up"]),
+    ] {
+        steps_of(&f, basis, &steps);
     }
     // a basis that does not time its steps writes none
     let plain = tmp("steps-plain");
@@ -453,7 +439,38 @@ fn a_study_through_cms_times_the_steps_of_its_basis() {
     assert!(timings.iter().all(|t| t.basis_steps.is_empty()));
     let written = String::from_utf8(bytes(&plain, "timings.jsonl")).unwrap();
     assert!(!written.contains("basis_steps"));
-    for d in [dir, plain] {
-        let _ = std::fs::remove_dir_all(d);
+    let _ = std::fs::remove_dir_all(plain);
+}
+
+/// A meso study through `basis`: every case times the basis's `steps` (names in order),
+/// within the basis's time, and the run's profile and mean list their sums.
+fn steps_of(f: &Fixture, basis: &str, steps: &[&str]) {
+    let mut def = meso_def(f);
+    def.solve.basis = basis.into();
+    let dir = tmp(&format!("steps-{basis}"));
+    let r = run(f, &def, &dir, RunOptions::default());
+    assert_eq!((r.computed, r.summary.failed), (6, 0), "{basis}");
+    let timings = StudyDir::new(&dir).timing_records().unwrap();
+    assert_eq!(timings.len(), 6);
+    for t in &timings {
+        let keys: Vec<&str> = t.basis_steps.keys().map(String::as_str).collect();
+        assert_eq!(keys, steps, "{basis}, case {}", t.id);
+        let sum: f64 = t.basis_steps.values().sum();
+        assert!(t.basis_steps.values().all(|s| s.is_finite() && *s >= 0.0));
+        // the steps are parts of the basis's time
+        assert!(sum <= t.basis_s * (1.0 + 1e-9), "case {}: {t:?}", t.id);
     }
+    for &step in steps {
+        let total: f64 = timings.iter().map(|t| t.basis_steps[step]).sum();
+        let row = r
+            .profile
+            .stages
+            .iter()
+            .find(|s| s.stage == format!("basis: {step}"))
+            .unwrap_or_else(|| panic!("{basis}: no profile row for {step}"));
+        assert!((row.time_s - total).abs() <= 1e-9 * total.max(1.0));
+        assert_eq!(row.count, 6);
+        assert!((r.timings.mean.basis_steps[step] - total / 6.0).abs() <= 1e-9 * total.max(1.0));
+    }
+    let _ = std::fs::remove_dir_all(dir);
 }

@@ -196,6 +196,12 @@ impl ReductionBasis for EnrichedBasis {
         let mut basis = Basis::new(v);
         basis.seed.real_modes = real_modes_seed(op, &modes);
         basis.dropped = dropped_modes + dropped_svd + dropped_static;
+        basis.steps = vec![
+            ("set-up".into(), t_factor),
+            ("real modes".into(), t_modes),
+            ("static responses".into(), t_statics),
+            ("orthonormalization".into(), t_orth),
+        ];
         basis.notes.push(format!(
             "{NAME}: {} real modes up to {cutoff:.1} Hz (`{}`) + {} static vectors of {loads} \
              friction loads ({} removed by the SVD cut{}, {} by the rank cut); {}; times: set-up \
@@ -257,6 +263,11 @@ impl EnrichedBasis {
         let mut basis = Basis::implicit(Arc::new(sb.columns), sb.projected);
         basis.seed.real_modes = real_modes_seed(op, &modes);
         basis.dropped = dropped_modes + sb.dropped_statics + sb.dropped_extra;
+        basis.steps = vec![
+            ("set-up".into(), t_factor),
+            ("real modes".into(), t_modes),
+            ("statics, orthonormalization and projection".into(), t_space),
+        ];
         basis.notes.push(format!(
             "{NAME}: {ns} static vectors of {loads} friction loads in the model's static \
              space ({} directions; {} removed by the rank cut) + {ne} real modes up to \

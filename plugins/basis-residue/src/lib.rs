@@ -266,6 +266,12 @@ impl ReductionBasis for ResidueBasis {
         basis.dropped = dropped;
         basis.iterations = iterations;
         basis.residual = Some(residual);
+        let t_iterations = clock.elapsed().as_secs_f64();
+        basis.steps = vec![
+            ("set-up".into(), t_factor),
+            ("real modes".into(), t_modes),
+            ("iterations".into(), t_iterations),
+        ];
         notes.insert(
             0,
             format!(
@@ -291,7 +297,7 @@ impl ReductionBasis for ResidueBasis {
                     .collect::<Vec<_>>(),
                 ks.method,
                 real_modes_cost(&modes),
-                clock.elapsed().as_secs_f64()
+                t_iterations
             ),
         );
         basis.notes = notes;
