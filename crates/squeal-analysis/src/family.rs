@@ -397,8 +397,14 @@ pub fn run_family_sweep(
     let step = |value: f64, op: &FrictionalOperator, mu: f64, changed: bool| {
         let out = method.solve(op, mu, changed)?;
         let t = method.last_times();
+        if t.basis_s > 0.0 {
+            solves.add("basis", t.basis_s);
+        }
+        // the basis's own steps, under its time
+        for (step, s) in method.last_basis_steps() {
+            solves.add(&format!("basis: {step}"), *s);
+        }
         for (stage, s) in [
-            ("basis", t.basis_s),
             ("projection", t.projection_s),
             ("eigen solve", t.solve_s),
             ("expansion + backward errors", t.expansion_s),

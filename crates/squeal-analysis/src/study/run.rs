@@ -289,14 +289,19 @@ pub fn run(
             ("contact set", t.contact_s),
             ("operator", t.operator_s),
             ("basis", t.basis_s),
+        ] {
+            profile.add(stage, s);
+        }
+        // the basis's own steps, under its time
+        for (step, s) in &t.basis_steps {
+            profile.add(&format!("basis: {step}"), *s);
+        }
+        for (stage, s) in [
             ("projection", t.projection_s),
             ("eigen solve", t.solve_s),
             ("expansion + backward errors", t.expansion_s),
         ] {
             profile.add(stage, s);
-        }
-        for (step, s) in &t.basis_steps {
-            profile.add(&format!("basis: {step}"), *s);
         }
     }
     let (summary, tsum) = finalize(dir, def, &list, records, timings)?;
