@@ -26,6 +26,7 @@ use crate::profile::{max_opt, peak_rss_mb, take_peak_rss_mb, Machine, Profile};
 use crate::reference::paper;
 use serde::Serialize;
 use squeal_contact::LoadedEquilibrium;
+use squeal_core::operator::ComplexModes;
 use squeal_core::{EigenParams, Params, Registry};
 use squeal_scene::{BodyKind, Scene};
 use std::path::Path;
@@ -301,11 +302,10 @@ pub fn run(
         prep.release_stages_except(&crate::pipeline::stage_keys(registry, ahead, band[1])?);
         // the references compare eigenvalues only: the mode shapes (n x modes, complex,
         // per basis and reference mu) are not kept for them
-        let values = sweep.kept.into_iter().map(|(mu, mut m)| {
-            m.vectors = squeal_core::faer::Mat::zeros(0, 0);
-            m.left_vectors = None;
-            (mu, m)
-        });
+        let values = sweep
+            .kept
+            .into_iter()
+            .map(|(mu, m)| (mu, eigenvalues_only(m)));
         kept.push((basis.clone(), values.collect::<Vec<_>>()));
         sweeps.push((basis.clone(), *step, summary));
         stage(&format!("sweep {basis} (step {step})"), &mut lap);
@@ -419,6 +419,14 @@ fn paper_rows_of(basis: &str, step: f64, summary: &SweepSummary) -> Vec<PaperRow
         .collect()
 }
 
+/// `modes` without their shapes (`n x modes` complex values each): what the comparison
+/// with full order reads.
+fn eigenvalues_only(mut modes: ComplexModes) -> ComplexModes {
+    modes.vectors = squeal_core::faer::Mat::zeros(0, 0);
+    modes.left_vectors = None;
+    modes
+}
+
 /// Full-order solves at the reference mu, and every swept basis against them. The
 /// equilibria (and the basis solves a resumed sweep did not keep) come first, on the
 /// whole prepared model; the full-order solves then run on the model and its contact set
@@ -428,7 +436,7 @@ fn references(
     prep: Prepared,
     s: &ValidateSettings,
     band: [f64; 2],
-    kept: &[(String, Vec<(f64, squeal_core::operator::ComplexModes)>)],
+    kept: &[(String, Vec<(f64, ComplexModes)>)],
 ) -> Result<Vec<RefRow>, RunError> {
     let params = EigenParams {
         fmin_hz: band[0],
@@ -464,7 +472,7 @@ fn references(
                     .map_err(at(mu))?;
                     method.prepare_stage_on(&prep).map_err(at(mu))?;
                     method.share_modal_cache(prep.modal_cache());
-                    method.solve(&op, mu, true).map_err(at(mu))?.0
+                    eigenvalues_only(method.solve(&op, mu, true).map_err(at(mu))?.0)
                 }
             });
         }
