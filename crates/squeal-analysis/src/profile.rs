@@ -83,9 +83,24 @@ impl Profile {
         }
     }
 
-    /// Sum of the stage times (s).
+    /// Sum of the stage times (s), the steps listed under a stage (`"<stage>: <step>"`,
+    /// such as a basis's, [`Profile::is_step`]) left out: they are part of its time.
     pub fn total_s(&self) -> f64 {
-        self.stages.iter().map(|s| s.time_s).sum()
+        self.stages
+            .iter()
+            .filter(|s| !self.is_step(&s.stage))
+            .map(|s| s.time_s)
+            .sum()
+    }
+
+    /// Whether `stage` is a step of another stage of this profile: its name is that
+    /// stage's followed by `": "` and the step's.
+    pub fn is_step(&self, stage: &str) -> bool {
+        self.stages.iter().any(|p| {
+            stage
+                .strip_prefix(p.stage.as_str())
+                .is_some_and(|rest| rest.len() > 2 && rest.starts_with(": "))
+        })
     }
 
     /// A Markdown table: stage, runs, time (s), share of `wall_s` (the run's wall time;
@@ -245,6 +260,15 @@ mod tests {
         assert_eq!(q.stages[1].stage, "sweep: solve");
         let md = p.markdown(12.0);
         assert!(md.contains("| basis | 2 | 5.0 | 42 % |"), "{md}");
+        // a step listed under a stage is part of its time, not more of it
+        p.add("basis: expansion", 4.0);
+        p.add("basis expansion", 0.5);
+        assert!(p.is_step("basis: expansion") && !p.is_step("basis expansion"));
+        assert!(!p.is_step("basis") && !p.is_step("basis: "));
+        assert!((p.total_s() - 6.5).abs() < 1e-15);
+        q.extend_prefixed("sweep: ", &p);
+        assert!(q.is_step("sweep: basis: expansion"));
+        assert!((q.total_s() - 12.5).abs() < 1e-15);
     }
 
     #[test]
