@@ -123,10 +123,10 @@ fn message(e: &anyhow::Error) -> String {
 /// large block afresh and return it to the system when freed, so every case faults its
 /// memory in again. One arena, not one per worker: a thread's own arena grows by heaps of
 /// at most 64 MiB and maps any larger block afresh whatever `M_MMAP_MAX` says (the contact
-/// set's operator, a few hundred MB on the meso scenes, would be faulted in at every case). On
-/// 24 layouts of the coupling-2 meso scene (2 workers, 2 cores) this takes a case from 3.56
-/// to 3.29 s, the page faults from 5.7 to 1.1 million and the peak RSS from 5.05 to 4.40
-/// GB against two arenas, with the same results to the bit; the other commands keep
+/// set's operator, a few hundred MB on the meso scenes, would be faulted in at every case).
+/// On 24 layouts of the coupling-2 meso scene (2 workers, 2 cores) this takes a case from
+/// 3.56 to 3.29 s, the page faults from 5.7 to 1.1 million and the peak RSS from 5,054 to
+/// 4,401 MB against two arenas, with the same results to the bit; the other commands keep
 /// glibc's defaults.
 fn tune_allocator_for_studies() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
