@@ -402,7 +402,7 @@ pub fn run_family_sweep(
         }
         // the basis's own steps, under its time
         for (step, s) in method.last_basis_steps() {
-            solves.add(&format!("basis: {step}"), *s);
+            solves.add_step("basis", step, *s);
         }
         for (stage, s) in [
             ("projection", t.projection_s),

@@ -67,6 +67,12 @@ impl Profile {
         }
     }
 
+    /// Adds `time_s` to the row of `step` listed under `stage` (named `"<stage>: <step>"`,
+    /// which [`Profile::is_step`] recognizes: part of the stage's time, not more of it).
+    pub fn add_step(&mut self, stage: &str, step: &str, time_s: f64) {
+        self.add(&format!("{stage}: {step}"), time_s);
+    }
+
     /// The largest stage peak (MB), where any was measured.
     pub fn peak_rss_mb(&self) -> Option<f64> {
         self.stages
@@ -261,7 +267,7 @@ mod tests {
         let md = p.markdown(12.0);
         assert!(md.contains("| basis | 2 | 5.0 | 42 % |"), "{md}");
         // a step listed under a stage is part of its time, not more of it
-        p.add("basis: expansion", 4.0);
+        p.add_step("basis", "expansion", 4.0);
         p.add("basis expansion", 0.5);
         assert!(p.is_step("basis: expansion") && !p.is_step("basis expansion"));
         assert!(!p.is_step("basis") && !p.is_step("basis: "));

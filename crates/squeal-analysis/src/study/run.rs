@@ -294,7 +294,7 @@ pub fn run(
         }
         // the basis's own steps, under its time
         for (step, s) in &t.basis_steps {
-            profile.add(&format!("basis: {step}"), *s);
+            profile.add_step("basis", step, *s);
         }
         for (stage, s) in [
             ("projection", t.projection_s),
