@@ -19,6 +19,10 @@ converged eigenvalue lies outside |s - sigma| > R. The EPS object (and with it t
 factor of K~ - sigma M~) is kept while nev grows: one factorization per window.
 Backward errors, the matching of modes and the side-by-side table are `scipy_compare.py`'s.
 
+Under `mpiexec -n N` the matrices are distributed by rows over the N processes (PETSc's
+default layout), MUMPS factorizes and solves on all of them, and the first process gathers
+the eigenvectors, computes the backward errors and writes the report.
+
 Writes slepc.json and, given squeal's `stability --json` output, prints the comparison.
 """
 
@@ -51,10 +55,27 @@ ORDERINGS = {"auto": (1, 7), "amd": (1, 0), "amf": (1, 2), "scotch": (1, 3), "po
 USED = {0: "amd", 1: "given", 2: "amf", 3: "scotch", 4: "pord", 5: "metis", 6: "qamd"}
 
 
+COMM = PETSc.COMM_WORLD
+ROOT = COMM.getRank() == 0
+
+
+def say(msg):
+    """Prints `msg` to standard error from the first process only."""
+    if ROOT:
+        print(msg, file=sys.stderr)
+
+
 def petsc_matrix(a):
+    """`a` as a PETSc AIJ matrix on every process, each holding its block of rows (PETSc's
+    default split: the first `n % size` processes one row more)."""
     a = a.tocsr()
     a.sort_indices()
-    return PETSc.Mat().createAIJ(size=a.shape, csr=(a.indptr, a.indices, a.data))
+    n, size, rank = a.shape[0], COMM.getSize(), COMM.getRank()
+    local = n // size + (1 if rank < n % size else 0)
+    start = rank * (n // size) + min(rank, n % size)
+    rows = a[start:start + local]
+    return PETSc.Mat().createAIJ(size=((local, n), (local, n)),
+                                 csr=(rows.indptr, rows.indices, rows.data), comm=COMM)
 
 
 class SlepcBand:
@@ -142,15 +163,23 @@ class SlepcBand:
             nev = min(2 * nev, self.cap)
         self.windows += 1
         its = e.getIterationNumber()
-        print(f"  slepc window [{lo:.0f}, {hi:.0f}] Hz: nev = {nev}, {nconv} converged, "
-              f"{its} restarts", file=sys.stderr)
+        say(f"  slepc window [{lo:.0f}, {hi:.0f}] Hz: nev = {nev}, {nconv} converged, "
+            f"{its} restarts")
         vr, vi = self.pk.createVecs()
+        gather, whole = PETSc.Scatter.toZero(vr)
+
+        def on_root(v):
+            # the whole vector on the first process (a collective call: every process
+            # makes it, in the same order, as keep_new's choices depend on values only)
+            gather.scatter(v, whole, PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+            return whole.getArray().copy() if ROOT else None
 
         def pairs():
             for j in range(nconv):
                 sj = e.getEigenpair(j, vr, vi)
                 # principal root: Im(lambda) >= 0; the vector is read before the next pair
-                vector = vr.getArray().copy() + 1j * vi.getArray().copy()
+                re, im = on_root(vr), on_root(vi)
+                vector = re + 1j * im if ROOT else None
                 yield 1j * np.sqrt(complex(sj)), lambda v=vector: v
 
         keep_new(self, lo, hi, pairs())
@@ -162,6 +191,8 @@ def solve_band(m, k, fmin, fmax, tol, ordering):
     t0 = time.perf_counter()
     band.window(fmin, fmax, 0, band.nev0)
     solve_s = time.perf_counter() - t0
+    if not ROOT:
+        return None, None, solve_s, band
     lam, eta = band_modes(band, m, k, fmin, fmax)
     return lam, eta, solve_s, band
 
@@ -177,17 +208,22 @@ def main():
     load_s = time.perf_counter() - t0
     version = ".".join(str(v) for v in SLEPc.Sys.getVersion())
     petsc_version = ".".join(str(v) for v in PETSc.Sys.getVersion())
-    print(f"SLEPc {version}, PETSc {petsc_version}: operator n = {m.shape[0]}, "
-          f"nnz(M~) = {m.nnz}, nnz(K~) = {k.nnz}, read in {load_s:.2f}s", file=sys.stderr)
+    procs = COMM.getSize()
+    say(f"SLEPc {version}, PETSc {petsc_version}: operator n = {m.shape[0]}, "
+        f"nnz(M~) = {m.nnz}, nnz(K~) = {k.nnz}, read in {load_s:.2f}s, {procs} MPI "
+        f"process(es)")
     lam, eta, solve_s, band = solve_band(m, k, fmin, fmax, args.tol, args.ordering)
     lu = PETSc.Log.Event("MatLUFactorNum").getPerfInfo()
     band.factorizations = int(lu["count"])
+    if not ROOT:
+        return
     settings = (f"EPS krylovschur GNHEP in s = -lambda^2, ST sinvert, KSP preonly, "
                 f"PC lu MUMPS ordering {args.ordering} (used: {band.ordering_used}), "
-                f"tol {args.tol:g} (EPS_CONV_REL), squeal's windows and nev doubling")
+                f"tol {args.tol:g} (EPS_CONV_REL), squeal's windows and nev doubling, "
+                f"{procs} MPI process(es)")
     report = {
         "solver": f"SLEPc {version} / PETSc {petsc_version}", "settings": settings,
-        "setup_s": band.setup_s, "factor_numeric_s": lu["time"],
+        "setup_s": band.setup_s, "factor_numeric_s": lu["time"], "mpi_processes": procs,
         "factor_entries": band.factor_entries,
     }
     extra = [("  of which factorization (s)", "", f"{band.setup_s:.2f}"),
