@@ -61,24 +61,22 @@ petsc_env() {
   [ -e /usr/lib/petsc ] || export PETSC_DIR="${PETSC_DIR:-$(ls -d /usr/lib/petscdir/petsc*/*-real 2>/dev/null | tail -n1)}"
   [ -e /usr/lib/slepc ] || export SLEPC_DIR="${SLEPC_DIR:-$(ls -d /usr/lib/slepcdir/slepc*/*-real 2>/dev/null | tail -n1)}"
 }
+# Debian packages, as root or through sudo
+apt_install() {
+  local sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo=sudo
+  echo "installing $* (apt-get)" >&2
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "$@" >/dev/null
+}
 petsc_env
 if ! "$py" -c "import slepc4py, petsc4py, scipy" >/dev/null 2>&1; then
-  sudo=""
-  [ "$(id -u)" -ne 0 ] && sudo=sudo
-  echo "installing python3-slepc4py-real python3-scipy (apt-get)" >&2
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq python3-slepc4py-real \
-    python3-scipy >/dev/null
+  apt_install python3-slepc4py-real python3-scipy
   petsc_env
 fi
 launch=("$py")
 if [ "$procs" -gt 1 ]; then
-  if ! command -v mpiexec >/dev/null 2>&1; then
-    sudo=""
-    [ "$(id -u)" -ne 0 ] && sudo=sudo
-    echo "installing openmpi-bin (apt-get)" >&2
-    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq openmpi-bin >/dev/null
-  fi
+  command -v mpiexec >/dev/null 2>&1 || apt_install openmpi-bin
   threads=$(( $(nproc) / procs ))
   [ "$threads" -ge 1 ] || threads=1
   export OPENBLAS_NUM_THREADS="$threads" OMP_NUM_THREADS="$threads"
