@@ -28,6 +28,37 @@ Subcommands
     Newton steps on ``det Q`` with sparse LU factors (two-sided Rayleigh quotient), kept as
     squeal keeps modes (``Im > 0``, frequency in the band, ``-Re <= Im``).
 
+``brake OUT [--nx NX --ny NY] [--reference] [--tune] [--no-modal]``
+    A brake-like operator on the same lattice whose SYMMETRIC stiffness part is indefinite
+    at high speed and which has a weakly unstable mode, the kind of model industrial
+    brake codes export (``K(W) = K1 + KR + W^2 KGeo``, ``C(W) = D1 + DR/W + W DG + DN``):
+
+    - ``KR``: a circulatory stiffness as large as a quarter of ``K1`` (norm), the
+      similarity ``T K1 T^-1 - K1`` with ``T = I + beta E``, ``E`` coupling each node's
+      x force to its y displacement (``E^2 = 0``, so ``T^-1 = I - beta E``, and ``T``
+      commutes with the lumped mass): ``K1 + KR`` keeps the real spectrum of ``K1``
+      while its symmetric part is nearly indefinite;
+    - ``D1``, ``DR``, ``DG``, ``DN`` seen through the same similarity (``T D T^-1``: a
+      non-symmetric damping and a gyroscopic part that is no longer skew), so that at
+      ``mu = 0`` the operator is ``T Q0(lambda) T^-1`` and has the spectrum of the
+      symmetric lattice ``Q0`` (a circulatory stiffness next to a skew gyroscopic part
+      would otherwise flutter on its own);
+    - ``KGeo``: a NEGATIVE geometric (softening) stiffness, the same on both DOFs of a
+      node (so it commutes with ``T`` too): the symmetric part of ``K`` is positive
+      definite at low ``W`` and indefinite above about ``W = 40``, while the undamped
+      operator's modes stay real up to ``W = 100``;
+    - ``DN``: a negative damping on the x DOFs of the contact patch (a friction
+      characteristic falling with the sliding speed), scaled so that ONE mode has
+      ``DvR = WEAK_DVR`` at ``(W, mu) = WEAK_AT``: unstable with a growth rate far below
+      any DvR threshold, yet certain (its error bound is orders of magnitude smaller);
+    - ``M``, ``FK`` and, before the similarity, ``D1``, ``DR``, ``DG`` as for ``operator``.
+
+    ``operator.toml`` also names the real-mode pair ``[modal] M = ["M"], K = ["K1"]``
+    (the undamped, non-rotating, friction-free system); ``--no-modal`` leaves it out. ``--tune`` finds the scale of
+    ``DN`` again (a dense eigenvalue solve and Newton steps on the weak mode, about a
+    minute) and prints it; the operator is written with the committed ``DN_SCALE``.
+    With ``--reference``, ``reference.json`` as for ``operator``, at ``BRAKE_CASES``.
+
 ``mat-fixtures OUT``
     Small MAT-files written by ``scipy.io.savemat`` (compressed and not) with the same
     matrices as Matrix Market files, plus files the reader must refuse.
@@ -127,6 +158,124 @@ def lattice(nx, ny):
     }
 
 
+# The brake operator (module docs, ``brake``).
+BETA = 0.5                 # strength of the circulatory similarity T = I + beta E
+GEO = 1.6e-3               # negative geometric stiffness per node (N/m per (rad/s)^2)
+WEAK_AT = (60.0, 0.0)      # (W, mu) where one mode is weakly unstable
+WEAK_DVR = 4e-8            # its divergence rate there
+DN_SCALE = 0.057984352218248374  # scale of DN, found by --tune: 172.881 Hz, DvR 4.0e-8
+BRAKE_CASES = [(5.0, 0.0), (60.0, 0.0), (60.0, 0.3), (100.0, 0.6)]
+
+
+def brake(nx, ny, dn_scale=None):
+    """Components of the brake operator (module docs), as CSC matrices."""
+    comp = lattice(nx, ny)
+    k1 = comp["K1"]
+    n = k1.shape[0]
+    # free DOFs come in node pairs (x, y) = (2p, 2p + 1); node of pair p
+    nodes = [a for a in range(nx * ny) if a // ny != 0]
+    e = sp.coo_matrix(
+        (np.ones(n // 2), (np.arange(0, n, 2), np.arange(1, n, 2))), shape=(n, n)
+    ).tocsc()
+    t, t_inv = sp.eye(n) + BETA * e, sp.eye(n) - BETA * e
+
+    def similar(x):
+        y = (t @ x @ t_inv).tocsc()
+        y.eliminate_zeros()
+        return y
+
+    comp["KR"] = (similar(k1) - k1).tocsc()
+    comp["KR"].eliminate_zeros()
+    comp["KGeo"] = sp.diags(
+        [-GEO * (1.0 + (a // ny) / nx) for a in nodes for _ in range(2)]
+    ).tocsc()
+    patch = {a for a in range(nx * ny) if a % ny == ny - 1 and nx // 3 <= a // ny < nx - 1}
+    xs = [2 * p for p, a in enumerate(nodes) if a in patch]
+    dn = sp.coo_matrix((-np.ones(len(xs)), (xs, xs)), shape=(n, n)).tocsc()
+    comp["DN"] = (DN_SCALE if dn_scale is None else dn_scale) * dn
+    # the damping and gyroscopic parts seen through the same similarity: at mu = 0 the
+    # operator is T Q0(lambda) T^-1, with the spectrum of the symmetric lattice Q0
+    for name in ["D1", "DR", "DG", "DN"]:
+        comp[name] = similar(comp[name])
+    return comp
+
+
+def assemble_brake(comp, w, mu):
+    m = comp["M"]
+    c = comp["D1"] + comp["DR"] / w + w * comp["DG"] + comp["DN"]
+    k = comp["K1"] + comp["KR"] + w * w * comp["KGeo"] - mu * comp["FK"]
+    return m.tocsc(), c.tocsc(), k.tocsc()
+
+
+def band_modes(m, c, k, fmax):
+    """Every eigenvalue in the band, dense (inverted companion form), unrefined."""
+    n = m.shape[0]
+    kd = k.toarray()
+    a = np.zeros((2 * n, 2 * n))
+    a[:n, :n] = -scipy.linalg.solve(kd, c.toarray())
+    a[:n, n:] = -scipy.linalg.solve(kd, m.toarray())
+    a[n:, :n] = np.eye(n)
+    del kd
+    nu = scipy.linalg.eigvals(a, overwrite_a=True, check_finite=False)
+    return band_of([1.0 / v for v in nu if v != 0], fmax)
+
+
+def two_sided(m, c, k, lam):
+    """Right and left eigenvectors at an (accurate) eigenvalue, by inverse iteration."""
+    n = m.shape[0]
+    q = (lam * lam * m + lam * c + k).tocsc().astype(complex)
+    lu = spla.splu(q)
+    rng = np.random.default_rng(11)
+    x = rng.standard_normal(n) + 1j * rng.standard_normal(n)
+    y = x.copy()
+    for _ in range(3):
+        x = lu.solve(x)
+        x /= np.linalg.norm(x)
+        y = lu.solve(y, trans="H")
+        y /= np.linalg.norm(y)
+    return x, y
+
+
+def tune(nx, ny, fmax):
+    """The scale of DN that gives one mode DvR = WEAK_DVR at WEAK_AT: first-order
+    sensitivities of every band mode to the scale pick the first mode to cross, then
+    Newton steps on that mode alone."""
+    comp = brake(nx, ny, dn_scale=0.0)
+    dn1 = brake(nx, ny, dn_scale=1.0)["DN"]
+    w, mu = WEAK_AT
+    m, c0, k = assemble_brake(comp, w, mu)
+    lams = [refine(m, c0, k, l) for l in band_modes(m, c0, k, fmax * 1.05)]
+    lams = band_of(lams, fmax)
+    best = None
+    for lam in lams:
+        x, y = two_sided(m, c0, k, lam)
+        d = -np.vdot(y, lam * (dn1 @ x)) / np.vdot(y, (2 * lam * m + c0) @ x)
+        if lam.real < 0 and d.real > 0:
+            s = -lam.real / d.real
+            print(f"  {lam.imag / 2 / np.pi:8.2f} Hz: DvR {lam.real / lam.imag:+.3e}, "
+                  f"crosses at scale ~{s:.4g}", file=sys.stderr)
+            if best is None or s < best[0]:
+                best = (s, lam)
+    if best is None:
+        raise SystemExit("tune: no stable mode is destabilized by DN")
+    scale, lam = best
+    for _ in range(30):
+        c = c0 + scale * dn1
+        lam = refine(m, c, k, lam, steps=6)
+        x, y = two_sided(m, c, k, lam)
+        d = -np.vdot(y, lam * (dn1 @ x)) / np.vdot(y, (2 * lam * m + c) @ x)
+        # target Re = WEAK_DVR Im; d(Re - WEAK_DVR Im)/ds
+        f = lam.real - WEAK_DVR * lam.imag
+        step = f / (d.real - WEAK_DVR * d.imag)
+        scale -= step
+        if abs(step) <= 1e-14 * abs(scale):
+            break
+    lam = refine(m, c0 + scale * dn1, k, lam, steps=6)
+    print(f"DN_SCALE = {float(scale)!r}  # {lam.imag / 2 / np.pi:.3f} Hz, "
+          f"DvR {lam.real / lam.imag:.4e} at W = {w}, mu = {mu}")
+    return scale
+
+
 def assemble(comp, w, mu):
     m = comp["M"]
     c = comp["D1"] + comp["DR"] / w + w * comp["DG"]
@@ -175,7 +324,7 @@ def refine(m, c, k, lam, steps=3):
     return lam
 
 
-def reference(comp, fmax, which):
+def reference(comp, fmax, which, assemble=assemble):
     cases = []
     for (w, mu) in which:
         m, c, k = assemble(comp, w, mu)
@@ -251,6 +400,62 @@ FK = ["FK"]
     print(f"{out}: {n} DOFs", file=sys.stderr)
 
 
+def write_brake(out, nx, ny, with_reference, fmax, which=BRAKE_CASES, modal=True):
+    os.makedirs(out, exist_ok=True)
+    comp = brake(nx, ny)
+    n = comp["M"].shape[0]
+    in_mtx = ["M", "K1", "D1", "FK"]
+    for name in in_mtx:
+        scipy.io.mmwrite(os.path.join(out, name + ".mtx"), comp[name], precision=17)
+    scipy.io.savemat(
+        os.path.join(out, "components.mat"),
+        {k: v for k, v in comp.items() if k not in in_mtx},
+        do_compression=True,
+    )
+    w, mu = WEAK_AT
+    toml = f"""# Brake-like parametric test operator written by benches/parametric_operator.py
+# ({nx} x {ny} lattice, {n} DOFs): circulatory KR, negative geometric stiffness KGeo
+# (the symmetric part of K is indefinite above about W = 40), a negative damping DN
+# that leaves one mode weakly unstable (DvR {WEAK_DVR:g} at W = {w:g}, mu = {mu:g}).
+format = "squeal-parametric-operator"
+version = 1
+parameter = "W"
+range = [1.0, 100.0]
+mat = "components.mat"
+M = ["M"]
+C = [{{ matrix = "D1" }}, {{ matrix = "DR", coeff = "1/W" }}, {{ matrix = "DG", coeff = "W" }}, "DN"]
+K = ["K1", "KR", {{ matrix = "KGeo", coeff = "W^2" }}]
+FK = ["FK"]
+"""
+    if modal:
+        toml += """
+# the real-mode pair: the undamped, non-rotating, friction-free system
+[modal]
+M = ["M"]
+K = ["K1"]
+"""
+    with open(os.path.join(out, "operator.toml"), "w") as f:
+        f.write(toml)
+    fp = {k: float(abs(v).sum()) for k, v in comp.items()}
+    with open(os.path.join(out, "fingerprint.json"), "w") as f:
+        json.dump({"dofs": n, "abs_sum": fp}, f, indent=1, sort_keys=True)
+    if with_reference:
+        ref = {
+            "source": "benches/parametric_operator.py brake: scipy.linalg.eigvals of the "
+                      "inverted companion form, Newton-refined with sparse LU (two-sided "
+                      "Rayleigh quotient)",
+            "dofs": n,
+            "lattice": [nx, ny],
+            "parameter": "W",
+            "fingerprint": fp,
+            "weak_mode": {"W": w, "mu": mu, "dvr": WEAK_DVR},
+            "cases": reference(comp, fmax, which, assemble=assemble_brake),
+        }
+        with open(os.path.join(out, "reference.json"), "w") as f:
+            json.dump(ref, f, indent=1)
+    print(f"{out}: {n} DOFs", file=sys.stderr)
+
+
 def mat_fixtures(out):
     os.makedirs(out, exist_ok=True)
     a = sp.csc_matrix(np.array([
@@ -295,6 +500,19 @@ def main():
     o.add_argument("--cases", default=None,
                    help="W:mu pairs of the reference, comma separated (default: "
                         + ",".join(f"{w:g}:{m:g}" for w, m in CASES) + ")")
+    b = sub.add_parser("brake")
+    b.add_argument("out")
+    b.add_argument("--nx", type=int, default=50)
+    b.add_argument("--ny", type=int, default=41)
+    b.add_argument("--fmax", type=float, default=1500.0)
+    b.add_argument("--reference", action="store_true")
+    b.add_argument("--tune", action="store_true")
+    b.add_argument("--no-modal", action="store_true",
+                   help="leave out the [modal] pair (squeal then builds one from the "
+                        "symmetric parts)")
+    b.add_argument("--cases", default=None,
+                   help="W:mu pairs of the reference, comma separated (default: "
+                        + ",".join(f"{w:g}:{m:g}" for w, m in BRAKE_CASES) + ")")
     f = sub.add_parser("mat-fixtures")
     f.add_argument("out")
     args = p.parse_args()
@@ -303,6 +521,14 @@ def main():
         if args.cases:
             which = [tuple(float(x) for x in c.split(":")) for c in args.cases.split(",")]
         write_operator(args.out, args.nx, args.ny, args.reference, args.fmax, which)
+    elif args.cmd == "brake":
+        if args.tune:
+            tune(args.nx, args.ny, args.fmax)
+        which = BRAKE_CASES
+        if args.cases:
+            which = [tuple(float(x) for x in c.split(":")) for c in args.cases.split(",")]
+        write_brake(args.out, args.nx, args.ny, args.reference, args.fmax, which,
+                    modal=not args.no_modal)
     else:
         mat_fixtures(args.out)
 

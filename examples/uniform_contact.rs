@@ -32,7 +32,7 @@ pub fn main() -> Result<(), Box<dyn std::error::Error>> {
         sweep.points.len(),
         sweep.time_s,
         sweep.couplings.len(),
-        settings.dvr_tol
+        settings.dvr_margin
     );
     for c in &sweep.couplings {
         let made_of: Vec<String> = c
@@ -72,7 +72,7 @@ pub fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut cms = Method::new(&reg, "cms", &Params::new(), "dense", "arpack", params)?;
     cms.prepare_stage_on(&prep)?;
     let (modes, size, _) = cms.solve(&op, mu, true)?;
-    let e = compare(&reference, &modes, band, settings.dvr_tol);
+    let e = compare(&reference, &modes, band, settings.dvr_margin);
     println!(
         "mu = {mu}: {} of {} pairs active; `cms` ({size} vectors) against full-order `arpack` \
          ({} modes): max df/f {:.1e}, max dDvR {:.1e}, missed {}, missed unstable {}",

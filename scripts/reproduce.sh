@@ -17,8 +17,12 @@
 #                   couplings, one patch size each (1 mm and 2 mm), 10 layouts per fraction
 #   bench           every basis x eigen solver at mu 0.3 and 0.7 against full order
 #   stress          the stress set (cases built to break methods)
+#   brake           the brake-like 4018-DOF operator (indefinite symmetric stiffness, a
+#                   weakly unstable mode): every basis with its [modal] pair and with the
+#                   pair squeal builds, and the sweep of W (needs Python with numpy, scipy)
 #
-# Extra arguments are passed to the command (e.g. `--jobs 1`, `--shard 1/2`).
+# Extra arguments are passed to the command (e.g. `--jobs 1`, `--shard 1/2`; for `brake`,
+# to its two benches).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 name=${1:-}
@@ -74,7 +78,23 @@ case "$name" in
     $squeal bench pin-on-disc --mu 0.3,0.7 --out out/bench "$@" ;;
   stress)
     $squeal bench pin-on-disc --stress --vary none --out out/stress "$@" ;;
+  brake)
+    py=${SQUEAL_PYTHON:-python3}
+    "$py" -c "import numpy, scipy" 2>/dev/null || py=/usr/bin/python3
+    mkdir -p out/brake
+    "$py" benches/parametric_operator.py brake out/brake/operator
+    "$py" benches/parametric_operator.py brake out/brake/operator-sym --no-modal
+    $squeal stability --operator out/brake/operator --param W=60 --mu 0 --band 0:500 \
+      --json out/brake/stability-w60.json
+    for op in operator operator-sym; do
+      $squeal bench --operator out/brake/$op --param W=60 --mu 0,0.3 --band 0:500 \
+        --out out/brake/bench-$op "$@"
+    done
+    resume=()
+    [ -d out/brake/sweep-w ] && resume=(--resume)
+    $squeal sweep param --operator out/brake/operator-sym --param W --from 20 --to 100 \
+      --step 5 --mu 0 --band 100:300 --out out/brake/sweep-w "${resume[@]}" ;;
   *)
-    sed -n '2,21p' "$0"
+    sed -n '2,24p' "$0"
     exit 2 ;;
 esac

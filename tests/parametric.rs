@@ -17,8 +17,11 @@
 //! stops with `MaxIterations`, whatever the restart cap; there it must say so, and every
 //! mode it does return must still match the reference to 1e-8.
 
+use squeal::analysis::bench::{bench_case, BenchOptions};
+use squeal::analysis::param_sweep::{run_into, ParamSweepSettings};
 use squeal::core::operator::ComplexModes;
-use squeal::core::{c64, EigenParams, EigenSolver, Params, StopReason};
+use squeal::core::reduction::real_mode_pair;
+use squeal::core::{c64, EigenParams, EigenSolver, Params, Stability, StopReason};
 use squeal_io::ParametricOperator;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -237,4 +240,181 @@ fn arpack_and_krylov_match_scipy_on_the_4k_parametric_operator() {
         );
     }
     check(&dir, &reference, "4018 DOFs", true);
+}
+
+/// Writes the brake-like operator of the script (`brake`, with or without its `[modal]`
+/// pair) into `dir`; `None` (and a message) when no Python has numpy and scipy.
+fn brake_operator(dir: &Path, modal: bool) -> Option<()> {
+    let py = python()?;
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/parametric_operator.py");
+    let mut cmd = Command::new(&py);
+    cmd.arg(&script).args(["brake", dir.to_str().unwrap()]);
+    if !modal {
+        cmd.arg("--no-modal");
+    }
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Some(())
+}
+
+/// The brake-like operator (docs/operators.md, test operators): its symmetric stiffness
+/// indefinite at W = 60, a weakly unstable mode there (DvR 4e-8) certain by its error
+/// bound. Full order matches the SciPy reference; the weak mode is unstable for
+/// `stability` (the class), `bench` (the reference's unstable modes) and `sweep param`
+/// (a coupling over W); every basis builds with the `[modal]` pair and with the pair
+/// squeal makes from the symmetric parts, and the latter is shifted only where the
+/// symmetric part is indefinite.
+#[test]
+fn the_brake_operator_runs_every_basis_and_its_weak_mode_is_unstable() {
+    let root = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let (with, sym) = (root.join("brake-4k"), root.join("brake-4k-sym"));
+    if brake_operator(&with, true).is_none() {
+        println!("SKIPPED: no Python with numpy and scipy (set SQUEAL_PYTHON)");
+        return;
+    }
+    brake_operator(&sym, false).unwrap();
+    let reference: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data().join("brake-4k.json")).unwrap())
+            .unwrap();
+    let fp: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(with.join("fingerprint.json")).unwrap())
+            .unwrap();
+    for (name, v) in reference["fingerprint"].as_object().unwrap() {
+        let (a, b) = (v.as_f64().unwrap(), fp["abs_sum"][name].as_f64().unwrap());
+        assert!(
+            (a - b).abs() <= 1e-12 * a,
+            "{name}: generator changed ({a} vs {b})"
+        );
+    }
+    let reg = squeal::registry();
+    let p = ParametricOperator::read(&with).unwrap();
+    let p_sym = ParametricOperator::read(&sym).unwrap();
+    let arpack: Box<dyn EigenSolver> = reg.eigen.create("arpack", &Params::new()).unwrap();
+    // full order against the reference, up to 400 Hz
+    let top = 400.0;
+    for (w, mu, _, lambda) in cases(&reference) {
+        let lambda: Vec<c64> = lambda
+            .into_iter()
+            .filter(|l| l.im / (2.0 * std::f64::consts::PI) <= top)
+            .collect();
+        let params = EigenParams {
+            fmax_hz: top,
+            tol: 1e-12,
+            ..EigenParams::default()
+        };
+        let modes = arpack
+            .solve_frictional(&p.at(w).unwrap(), mu, &params)
+            .unwrap();
+        let err = compare(&lambda, &modes, top)
+            .unwrap_or_else(|e| panic!("brake W = {w} mu = {mu}: {e}"));
+        println!(
+            "brake arpack W = {w:>5} mu = {mu:>4}: {} modes, max rel error {err:.2e}",
+            modes.len()
+        );
+        assert!(err <= TOL, "brake W = {w} mu = {mu}: {err:e}");
+    }
+    // the pair: [modal] as given; the symmetric parts definite at W = 5, shifted at W = 60
+    let at60 = p.at(60.0).unwrap();
+    let pair = real_mode_pair(&at60).unwrap();
+    assert!(
+        pair.shift == 0.0 && pair.source.contains("[modal]"),
+        "{}",
+        pair.source
+    );
+    let sym60 = p_sym.at(60.0).unwrap();
+    let pair = real_mode_pair(&sym60).unwrap();
+    assert!(
+        pair.shift > 0.0 && pair.source.contains("negative"),
+        "{}",
+        pair.source
+    );
+    assert_eq!(real_mode_pair(&p_sym.at(5.0).unwrap()).unwrap().shift, 0.0);
+    // the weak mode: unstable by its class, far below any DvR threshold, certain
+    let band = EigenParams {
+        fmin_hz: 100.0,
+        fmax_hz: 300.0,
+        ..EigenParams::default()
+    };
+    let modes = arpack.solve_frictional(&at60, 0.0, &band).unwrap();
+    let unstable: Vec<usize> = (0..modes.len())
+        .filter(|&i| modes.stability(i, 0.0) == Stability::Unstable)
+        .collect();
+    assert_eq!(unstable.len(), 1, "{:?}", modes.dvr);
+    let i = unstable[0];
+    let v = modes.verdict(i, 0.0);
+    println!(
+        "weak mode: {:.3} Hz, DvR {:.3e}, Re {:.3e} 1/s, bound {:.2e} 1/s",
+        modes.freq_hz[i], modes.dvr[i], modes.lambda[i].re, v.re_bound
+    );
+    assert!(modes.dvr[i] > 0.0 && modes.dvr[i] < 1e-6);
+    assert!(v.re_bound < 1e-2 * modes.lambda[i].re, "{v:?}");
+    assert_eq!(modes.class_counts(0.0), [1, 0, modes.len() - 1]);
+    // a physical margin above its DvR leaves it neutral
+    assert_eq!(modes.stability(i, 1e-6), Stability::Neutral);
+    let weak_hz = modes.freq_hz[i];
+    // bench: every basis on both operators, the reference counts the weak mode
+    for (label, op) in [("[modal]", &at60), ("symmetric parts", &sym60)] {
+        let mut opts = BenchOptions::all(&reg);
+        opts.band_hz = [100.0, 300.0];
+        opts.eigens = vec!["dense".into()];
+        let (refsolve, runs) =
+            bench_case(&reg, "W=60", op, &Vec::new(), 0.0, &opts, None, |_| {}).unwrap();
+        assert_eq!(
+            refsolve.unstable.len(),
+            1,
+            "{label}: {:?}",
+            refsolve.unstable
+        );
+        assert!((refsolve.unstable[0][0] - weak_hz).abs() < 1e-6 * weak_hz);
+        for basis in ["modes", "enriched", "residue", "pod", "cms"] {
+            let r = runs
+                .iter()
+                .find(|r| r.basis == basis)
+                .unwrap_or_else(|| panic!("{label}: no `{basis}` run"));
+            assert_eq!(r.status, "ok", "{label} {basis}: {}", r.status);
+            assert!(
+                r.basis_size > 0 && r.errors.max_backward_error.is_finite(),
+                "{label} {basis}"
+            );
+            println!(
+                "{label:<16} {basis:<9} n = {:>4}: max rel freq error {:.1e}, missed {} of {} \
+                 modes, {} unstable missed, {} neutral",
+                r.basis_size,
+                r.errors.max_rel_freq_err,
+                r.errors.missed_modes,
+                r.errors.reference_modes,
+                r.errors.missed_unstable,
+                r.errors.neutral
+            );
+        }
+    }
+    // sweep param tracks it over W: a coupling near its frequency from W = 60
+    let out = root.join("brake-4k-sweep");
+    let _ = std::fs::remove_dir_all(&out);
+    let settings = ParamSweepSettings {
+        from: 50.0,
+        to: 70.0,
+        step: 5.0,
+        mu: Some(0.0),
+        basis: "none".into(),
+        basis_params: Params::new(),
+        eigen: "arpack".into(),
+        band_hz: [100.0, 300.0],
+        tol: 1e-10,
+        dvr_margin: 0.0,
+        condition: false,
+    };
+    let (summary, _) = run_into(&reg, &sym, &p_sym, "W", &settings, &out, false, |_| {}).unwrap();
+    assert!(summary.reference.contains("negative") || summary.reference.contains("definite"));
+    let c = summary
+        .couplings
+        .iter()
+        .find(|c| (c.freq_hz - weak_hz).abs() < 0.01 * weak_hz)
+        .unwrap_or_else(|| panic!("no coupling near {weak_hz} Hz: {:?}", summary.couplings));
+    assert_eq!(c.from, 60.0, "{c:?}");
+    assert!(c.max_dvr < 1e-4, "{c:?}");
 }

@@ -25,13 +25,13 @@ fn fixture() -> Fixture {
 
 fn solve() -> SolveSpec {
     SolveSpec {
-        basis: "modes".into(),
+        basis: "cms".into(),
         basis_params: Vec::new(),
         eigen: "dense".into(),
         modal: "arpack".into(),
         band_hz: [0.0, 5000.0],
         tol: 1e-10,
-        dvr_tol: 1e-6,
+        dvr_margin: 0.0,
         classes_hz: vec![2100.0, 3500.0],
         class_width: 0.2,
     }
@@ -434,7 +434,9 @@ fn a_study_lists_the_timed_steps_of_its_basis() {
     }
     // a basis that does not time its steps writes none
     let plain = tmp("steps-plain");
-    run(&f, &meso_def(&f), &plain, RunOptions::default());
+    let mut def = meso_def(&f);
+    def.solve.basis = "modes".into();
+    run(&f, &def, &plain, RunOptions::default());
     let timings = StudyDir::new(&plain).timing_records().unwrap();
     assert!(timings.iter().all(|t| t.basis_steps.is_empty()));
     let written = String::from_utf8(bytes(&plain, "timings.jsonl")).unwrap();

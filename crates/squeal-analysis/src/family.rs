@@ -8,9 +8,11 @@
 //! **Reference modes.** Tracking compares modes by their signatures on real reference
 //! modes ([`crate::sweep`]). A scene has its free-interface modes (no contact). An operator
 //! read from files has no model, so [`reference_modes`] builds them from the operator
-//! itself: the real modes of the symmetric parts `(K + K^T)/2`, `(M + M^T)/2` of its
-//! friction-free parts at the sweep's first value (no damping, no gyroscopic or
-//! circulatory term, no friction), up to 1.5 times the band top, computed once. They are
+//! itself: the real modes of its real-mode pair at the sweep's first value (the pair its
+//! directory names in `[modal]`, else the symmetric parts `(K + K^T)/2`, `(M + M^T)/2` of
+//! its friction-free parts, shifted positive definite when the stiffness's is not; no
+//! damping, no gyroscopic or circulatory term, no friction), up to 1.5 times the band
+//! top, computed once. They are
 //! `M`-orthonormal for that mass, so the signature MAC is the MAC of the modes projected on
 //! them; it stays meaningful along the sweep as long as the modes of the band remain in
 //! their span (a parameter that moves modes far out of the band's reference span loses
@@ -24,7 +26,8 @@ use crate::sweep::{
 };
 use serde::Serialize;
 use squeal_core::operator::ComplexModes;
-use squeal_core::{EigenParams, FrictionalOperator, Params, Registry, SparseMat, SymmetricProblem};
+use squeal_core::reduction::real_mode_pair;
+use squeal_core::{EigenParams, FrictionalOperator, Params, Registry, SymmetricProblem};
 use std::time::Instant;
 
 /// The operator of one value of the swept parameter.
@@ -151,32 +154,11 @@ impl OperatorFamily for Parametric<'_> {
     }
 }
 
-/// `(A + A^T) / 2`.
-fn symmetric_part(a: &SparseMat) -> Result<SparseMat> {
-    let mut t = Vec::with_capacity(a.compute_nnz());
-    for j in 0..a.ncols() {
-        for (i, v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
-            t.push(squeal_core::faer::sparse::Triplet::new(j, i, *v));
-        }
-    }
-    let at = SparseMat::try_new_from_triplets(a.ncols(), a.nrows(), &t).map_err(|e| {
-        PipelineError::Core {
-            stage: "reference modes: transpose".into(),
-            source: squeal_core::Error::Invalid(format!("{e:?}")),
-        }
-    })?;
-    squeal_core::linalg::add_scaled(a.as_ref(), 0.5, at.as_ref(), 0.5).map_err(|source| {
-        PipelineError::Core {
-            stage: "reference modes: symmetric part".into(),
-            source,
-        }
-    })
-}
-
 /// The reference modes of tracking for an operator without a model (module docs): the
-/// real modes of the symmetric parts of `op`'s mass and stiffness (`M_c`, `K_c`, friction
-/// parts left out) up to `fmax_hz`, by the symmetric solver `eigen`, labelled `ref 1`,
-/// `ref 2`, ... in increasing frequency.
+/// real modes of its real-mode pair ([`squeal_core::reduction::real_mode_pair`]: the
+/// pair its directory names, else the symmetric parts of `M_c` and `K_c`, shifted
+/// positive definite when the stiffness's is not) up to `fmax_hz`, by the symmetric
+/// solver `eigen`, labelled `ref 1`, `ref 2`, ... in increasing frequency.
 pub fn reference_modes(
     registry: &Registry,
     op: &FrictionalOperator,
@@ -191,28 +173,28 @@ pub fn reference_modes(
         .eigen
         .create(eigen, &Params::new())
         .map_err(stage("eigen solver"))?;
-    let (m, k) = (symmetric_part(&op.mc)?, symmetric_part(&op.kc)?);
+    let pair = real_mode_pair(op).map_err(stage("reference modes of tracking"))?;
+    let (m, k) = (pair.m, pair.k);
     let modes = solver
         .solve_symmetric(
-            &SymmetricProblem {
-                k: k.as_ref(),
-                m: m.as_ref(),
-            },
+            &SymmetricProblem { k, m },
             &EigenParams {
-                fmax_hz,
+                fmax_hz: pair.shifted_cutoff_hz(fmax_hz),
                 ..EigenParams::default()
             },
         )
-        .map_err(stage(
-            "reference modes of tracking (real modes of the symmetric part)",
-        ))?;
+        .map_err(stage(&format!(
+            "reference modes of tracking (real modes of {})",
+            pair.source
+        )))?;
+    let modes = pair.unshift(modes);
     let n = m.nrows();
     let kk = modes.freq_hz.len();
     let mut mphi = squeal_core::faer::Mat::<f64>::zeros(n, kk);
     let mut y = vec![0.0; n];
     for c in 0..kk {
         let x: Vec<f64> = modes.vectors.col(c).iter().copied().collect();
-        squeal_core::linalg::spmv(m.as_ref(), &x, &mut y);
+        squeal_core::linalg::spmv(m, &x, &mut y);
         for r in 0..n {
             mphi[(r, c)] = y[r];
         }
@@ -377,7 +359,7 @@ pub struct FamilySweep {
 }
 
 /// Runs `method` over `values` of `family` (signatures on `reference`), then tracks the
-/// branches and finds the couplings (DvR above `dvr_tol`) with their make-up on
+/// branches and finds the couplings (DvR above `dvr_margin`) with their make-up on
 /// `reference`. The complex modes at the values of `keep_modes_at` are kept. Finished
 /// points go to `checkpoint`; `progress` sees every point.
 #[allow(clippy::too_many_arguments)]
@@ -386,7 +368,7 @@ pub fn run_family_sweep(
     values: &[f64],
     method: &mut Method,
     reference: &FreeModes,
-    dvr_tol: f64,
+    dvr_margin: f64,
     keep_modes_at: &[f64],
     checkpoint: Option<&Checkpoint>,
     progress: impl FnMut(&SweepPoint),
@@ -432,7 +414,7 @@ pub fn run_family_sweep(
     profile.extend_prefixed("", &solves);
     let t = Instant::now();
     let branches = track(&points, &TrackOptions::default());
-    let couplings = couplings(&points, &branches, dvr_tol)
+    let couplings = couplings(&points, &branches, dvr_margin)
         .iter()
         .map(|c| SweepCoupling {
             freq_hz: c.freq_hz,

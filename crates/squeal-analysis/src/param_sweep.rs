@@ -37,8 +37,10 @@ pub struct ParamSweepSettings {
     pub band_hz: [f64; 2],
     /// Relative tolerance of the eigen solves.
     pub tol: f64,
-    /// A mode is unstable when its DvR exceeds this.
-    pub dvr_tol: f64,
+    /// Physical margin on the divergence rate: a mode counts as unstable only when its DvR
+    /// = Re/Im also exceeds this (0: its real part against its forward error bound alone
+    /// decides, `squeal_core::operator::classify`).
+    pub dvr_margin: f64,
     /// Condition numbers of full-order modes above the solvers' automatic size.
     pub condition: bool,
 }
@@ -64,8 +66,10 @@ pub struct ParamSummary {
     pub basis: String,
     /// Size of the operator.
     pub dofs: usize,
-    /// A mode is unstable when its DvR exceeds this.
-    pub dvr_tol: f64,
+    /// Physical margin on the divergence rate: a mode counts as unstable only when its DvR
+    /// = Re/Im also exceeds this (0: its real part against its forward error bound alone
+    /// decides, `squeal_core::operator::classify`).
+    pub dvr_margin: f64,
     /// Points of the sweep.
     pub points: usize,
     /// Largest basis.
@@ -85,11 +89,12 @@ pub struct ParamSummary {
     pub couplings: Vec<SweepCoupling>,
 }
 
-/// What the reference modes of a parameter sweep are.
-fn reference_text(name: &str, value: f64, reference: &FreeModes) -> String {
+/// What the reference modes of a parameter sweep are: the real modes of the operator's
+/// real-mode pair at the first value (`pair`, its description).
+fn reference_text(reference: &FreeModes, pair: &str) -> String {
     format!(
-        "{} real modes ({:.1} to {:.1} Hz) of the symmetric parts of M and K at {name} = \
-         {value} (no damping, gyroscopic, circulatory or friction term)",
+        "{} real modes ({:.1} to {:.1} Hz) of the real-mode pair: {pair} (no damping, \
+         gyroscopic, circulatory or friction term)",
         reference.freq_hz.len(),
         reference.freq_hz.first().copied().unwrap_or(0.0),
         reference.freq_hz.last().copied().unwrap_or(0.0),
@@ -136,12 +141,9 @@ pub fn run_into(
             format!("{} at {name} = {}: {e}", dir.display(), values[0]),
         )
     })?;
-    let frictional = first.fm.compute_nnz() > 0
-        || first.fk.compute_nnz() > 0
-        || first.fc.as_ref().is_some_and(|f| f.compute_nnz() > 0);
     let mu = match s.mu {
         Some(mu) => mu,
-        None if frictional => {
+        None if first.has_friction() => {
             return Err(RunError::input(
                 "mu",
                 format!(
@@ -202,7 +204,7 @@ pub fn run_into(
         &values,
         &mut method,
         &reference,
-        s.dvr_tol,
+        s.dvr_margin,
         &[],
         Some(&ckpt),
         |p| events(SweepEvent::Point(p)),
@@ -214,7 +216,7 @@ pub fn run_into(
         name,
         points,
         &sweep.branches,
-        s.dvr_tol,
+        s.dvr_margin,
     )?;
     let summary = ParamSummary {
         operator: dir.display().to_string(),
@@ -226,7 +228,7 @@ pub fn run_into(
         eigen: s.eigen.clone(),
         basis: s.basis.clone(),
         dofs: first.dim(),
-        dvr_tol: s.dvr_tol,
+        dvr_margin: s.dvr_margin,
         points: points.len(),
         max_basis_size: points.iter().map(|p| p.basis_size).max().unwrap_or(0),
         max_backward_error: points
@@ -234,7 +236,12 @@ pub fn run_into(
             .flat_map(|p| p.modes.iter().map(|m| m.backward_error))
             .fold(0.0, f64::max),
         max_error_bound: max_error_bound(points),
-        reference: reference_text(name, values[0], &reference),
+        reference: reference_text(
+            &reference,
+            &squeal_core::reduction::real_mode_pair(&first)
+                .map(|p| p.source.into_owned())
+                .unwrap_or_default(),
+        ),
         reference_modes: reference.freq_hz.len(),
         time_s: start.elapsed().as_secs_f64(),
         couplings: sweep.couplings.clone(),

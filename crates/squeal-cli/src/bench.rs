@@ -62,9 +62,11 @@ pub struct BenchArgs {
     /// Relative tolerance of the benchmarked eigen solvers.
     #[arg(long, default_value = "1e-10")]
     tol: f64,
-    /// A mode is unstable when its divergence rate DvR = Re/Im exceeds this.
-    #[arg(long, default_value = "1e-6")]
-    dvr_tol: f64,
+    /// Physical margin on the divergence rate: a mode counts as unstable only when its DvR
+    /// = Re/Im also exceeds this (0: its real part against its forward error bound alone
+    /// decides, `squeal_core::operator::classify`).
+    #[arg(long, visible_alias = "dvr-tol", default_value = "0")]
+    dvr_margin: f64,
     /// Full-order reference solver.
     #[arg(long, default_value = "arpack")]
     reference: String,
@@ -126,8 +128,8 @@ impl BenchArgs {
         opts.vary = parse_vary(&self.vary)?;
         crate::opts::check_tol("--tol", self.tol)?;
         crate::opts::check_tol("--reference-tol", self.reference_tol)?;
-        if !(self.dvr_tol.is_finite() && self.dvr_tol >= 0.0) {
-            anyhow::bail!("--dvr-tol {}: expected a number >= 0", self.dvr_tol);
+        if !(self.dvr_margin.is_finite() && self.dvr_margin >= 0.0) {
+            anyhow::bail!("--dvr-margin {}: expected a number >= 0", self.dvr_margin);
         }
         for &mu in &self.mu {
             crate::opts::check_mu("--mu", mu)?;
@@ -138,7 +140,7 @@ impl BenchArgs {
             .map(crate::opts::parse_band)
             .transpose()?;
         opts.tol = self.tol;
-        opts.dvr_tol = self.dvr_tol;
+        opts.dvr_margin = self.dvr_margin;
         opts.reference_eigen = self.reference.clone();
         opts.reference_tol = self.reference_tol;
         opts.condition = self.condition;
@@ -197,8 +199,8 @@ fn print_run(r: &BenchRun) {
     };
     println!(
         "  {:<26} n={:<6} setup {:>7.2} s  solve {:>7.2} s{split}  df/f {:>8.1e}  \
-         dDvR {:>8.1e}  missed {} modes, {} unstable; false unstable {}  bwd {:>8.1e}  \
-         bound {:>8}  {}{}",
+         dDvR {:>8.1e}  missed {} modes, {} unstable; false unstable {}; {} neutral  \
+         bwd {:>8.1e}  bound {:>8}  {}{}",
         format!("{}/{}{opts}", r.basis, r.eigen),
         if r.basis_size == 0 {
             r.dofs
@@ -212,6 +214,7 @@ fn print_run(r: &BenchRun) {
         r.errors.missed_modes,
         r.errors.missed_unstable,
         r.errors.false_unstable,
+        r.errors.neutral,
         r.errors.max_backward_error,
         crate::stability::sci(r.errors.max_error_bound),
         times(r.solve_speedup),
@@ -312,10 +315,12 @@ pub fn run(registry: &Registry, a: &Args<'_>, probe: Option<&dyn MemoryProbe>) -
             SuiteEvent::Case(case, what) => println!("case {case}: {what}"),
             SuiteEvent::Run(r) => print_run(r),
             SuiteEvent::Reference(r) => println!(
-                "  reference `{}`: {} modes in band, {} unstable, {:.1} s",
+                "  reference `{}`: {} modes in band, {} unstable, {} neutral within their \
+                 error bound, {:.1} s",
                 r.eigen,
                 r.modes,
                 r.unstable.len(),
+                r.neutral.len(),
                 r.time_s
             ),
         },

@@ -148,6 +148,7 @@ pub fn charts(out: &Path, runs: &[BenchRun]) -> Result<Vec<PathBuf>> {
                     name,
                     points: vec![p],
                     style: SeriesStyle::LineMarkers,
+                    neutral: Vec::new(),
                     highlight: Vec::new(),
                 }),
             }
@@ -187,6 +188,7 @@ mod tests {
             name: name.into(),
             points: pts.to_vec(),
             style: SeriesStyle::LineMarkers,
+            neutral: Vec::new(),
             highlight: Vec::new(),
         };
         let merged = merged_series(vec![

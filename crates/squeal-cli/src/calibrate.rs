@@ -202,6 +202,7 @@ fn chart(out: &Path, fit: &FitResult) -> Result<Vec<PathBuf>> {
                 },
                 points,
                 style,
+                neutral: Vec::new(),
                 highlight: Vec::new(),
             });
         }

@@ -129,9 +129,11 @@ pub struct MethodArgs {
     /// Relative tolerance of the eigen solvers.
     #[arg(long, default_value = "1e-10")]
     pub tol: f64,
-    /// A mode is unstable when its divergence rate DvR = Re/Im exceeds this.
-    #[arg(long, default_value = "1e-6")]
-    pub dvr_tol: f64,
+    /// Physical margin on the divergence rate: a mode counts as unstable only when its DvR
+    /// = Re/Im also exceeds this (0: its real part against its forward error bound alone
+    /// decides, `squeal_core::operator::classify`).
+    #[arg(long, visible_alias = "dvr-tol", default_value = "0")]
+    pub dvr_margin: f64,
 }
 
 impl MethodArgs {
@@ -175,8 +177,8 @@ impl MethodArgs {
             parse_band(b)?;
         }
         check_tol("--tol", self.tol)?;
-        if !(self.dvr_tol.is_finite() && self.dvr_tol >= 0.0) {
-            anyhow::bail!("--dvr-tol {}: expected a number >= 0", self.dvr_tol);
+        if !(self.dvr_margin.is_finite() && self.dvr_margin >= 0.0) {
+            anyhow::bail!("--dvr-margin {}: expected a number >= 0", self.dvr_margin);
         }
         if self.basis == "none" {
             if !self.basis_opt.is_empty() {

@@ -4,7 +4,7 @@
 use anyhow::{Context, Result};
 use serde::Serialize;
 use squeal_analysis::pipeline::Prepared;
-use squeal_core::{EigenParams, FrictionalOperator, Registry};
+use squeal_core::{EigenParams, FrictionalOperator, Registry, Stability};
 use std::path::Path;
 use std::time::Instant;
 
@@ -15,7 +15,14 @@ pub struct ModeOut {
     pub re: f64,
     pub im: f64,
     pub dvr: f64,
+    /// Whether the mode is unstable (`stability == "unstable"`).
     pub unstable: bool,
+    /// `unstable`, `neutral` or `stable`: the real part against its forward error bound
+    /// (`re_bound`), and the DvR against the physical margin `dvr_margin` when one is set.
+    pub stability: &'static str,
+    /// Forward error bound of the real part (1/s), `cond x backward_error x |lambda|`
+    /// (null when the sign of a real part far beyond any bound decided the class alone).
+    pub re_bound: f64,
     pub backward_error: f64,
     /// Condition number of the eigenvalue (null when not computed: full order above 1000
     /// DOFs without --condition).
@@ -41,7 +48,7 @@ pub struct StabilityReport {
     pub basis_time_s: f64,
     pub band_hz: [f64; 2],
     pub tol: f64,
-    pub dvr_tol: f64,
+    pub dvr_margin: f64,
     pub active_pairs: Option<usize>,
     pub pairs: Option<usize>,
     /// The scene's damping (`none`, or its Rayleigh coefficients and contact dashpots), or
@@ -58,6 +65,10 @@ pub struct StabilityReport {
     pub max_backward_error: f64,
     /// Worst `error_bound` of the modes (null when not computed).
     pub max_error_bound: f64,
+    /// How many modes are unstable, neutral (within their bound) and stable.
+    pub unstable: usize,
+    pub neutral: usize,
+    pub stable: usize,
     pub modes: Vec<ModeOut>,
 }
 
@@ -74,7 +85,8 @@ pub struct StabilityArgs {
     /// the name its operator.toml declares, e.g. `W=5`.
     #[arg(long, value_name = "NAME=VALUE")]
     param: Option<String>,
-    /// Friction coefficient (default: the scene's study.mu; required with --operator).
+    /// Friction coefficient (default: the scene's study.mu; with --operator, required when
+    /// the operator has friction parts, else 0).
     #[arg(long)]
     mu: Option<f64>,
     #[command(flatten)]
@@ -119,7 +131,7 @@ impl StabilityArgs {
             eigen: &eigen,
             band: self.method.band.clone(),
             tol: self.method.tol,
-            dvr_tol: self.method.dvr_tol,
+            dvr_margin: self.method.dvr_margin,
             contact: &self.contact,
         };
         let report = run(registry, &args)?;
@@ -177,7 +189,7 @@ pub struct Args<'a> {
     /// `--band` as given; `None`: the scene's band.
     pub band: Option<String>,
     pub tol: f64,
-    pub dvr_tol: f64,
+    pub dvr_margin: f64,
     /// Equilibrium solver, contact law and its parameters.
     pub contact: &'a crate::opts::ContactArgs,
     pub basis: &'a str,
@@ -207,7 +219,14 @@ pub fn source(registry: &Registry, a: &Args<'_>) -> Result<Source> {
         }
         let start = Instant::now();
         let op = crate::opts::read_operator_at(dir, a.param)?;
-        let mu = a.mu.context("--mu is required with --operator")?;
+        let mu = match a.mu {
+            Some(mu) => mu,
+            None if op.has_friction() => anyhow::bail!(
+                "--mu: required, the operator in {} has friction parts (X - mu F_X)",
+                dir.display()
+            ),
+            None => 0.0,
+        };
         squeal_contact::check_user_mu(mu)?;
         let damping = if op.cc.is_some() || op.fc.is_some() {
             "read from the operator files (C_c, F_C)".into()
@@ -283,17 +302,23 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
     }
     let (modes, basis_size, basis_time_s) = method.solve(&src.op, src.mu, true)?;
     let out: Vec<ModeOut> = (0..modes.len())
-        .map(|i| ModeOut {
-            freq_hz: modes.freq_hz[i],
-            re: modes.lambda[i].re,
-            im: modes.lambda[i].im,
-            dvr: modes.dvr[i],
-            unstable: modes.is_unstable(i, a.dvr_tol),
-            backward_error: modes.backward_error[i],
-            cond: modes.cond[i],
-            error_bound: modes.error_bound[i],
+        .map(|i| {
+            let v = modes.verdict(i, a.dvr_margin);
+            ModeOut {
+                freq_hz: modes.freq_hz[i],
+                re: modes.lambda[i].re,
+                im: modes.lambda[i].im,
+                dvr: modes.dvr[i],
+                unstable: v.class == Stability::Unstable,
+                stability: v.class.name(),
+                re_bound: v.re_bound,
+                backward_error: modes.backward_error[i],
+                cond: modes.cond[i],
+                error_bound: modes.error_bound[i],
+            }
         })
         .collect();
+    let [unstable, neutral, stable] = modes.class_counts(a.dvr_margin);
     Ok(StabilityReport {
         source: src.name,
         param: a.param.map(str::to_string),
@@ -307,7 +332,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
         basis_time_s,
         band_hz: band,
         tol: a.tol,
-        dvr_tol: a.dvr_tol,
+        dvr_margin: a.dvr_margin,
         active_pairs: src.active_pairs,
         pairs: src.pairs,
         damping: src.damping,
@@ -321,6 +346,9 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<StabilityReport> {
         notes: modes.info.notes.clone(),
         max_backward_error: modes.backward_error.iter().fold(0.0, |m: f64, &b| m.max(b)),
         max_error_bound: squeal_analysis::sweep::files::worst(&modes.error_bound),
+        unstable,
+        neutral,
+        stable,
         modes: out,
     })
 }
@@ -352,25 +380,45 @@ pub fn print(r: &StabilityReport) {
         println!("damping: {}", r.damping);
     }
     println!(
-        "{:>4} {:>12} {:>14} {:>12} {:>9} {:>10} {:>10} {:>10}",
-        "#", "freq (Hz)", "Re (1/s)", "DvR", "unstable", "backward", "cond", "err bound"
+        "{:>4} {:>12} {:>14} {:>12} {:>9} {:>10} {:>10} {:>10} {:>10}",
+        "#", "freq (Hz)", "Re (1/s)", "DvR", "class", "Re bound", "backward", "cond", "err bound"
     );
     for (i, m) in r.modes.iter().enumerate() {
         println!(
-            "{:>4} {:>12.3} {:>14} {:>12} {:>9} {:>10.1e} {:>10} {:>10}",
+            "{:>4} {:>12.3} {:>14} {:>12} {:>9} {:>10} {:>10.1e} {:>10} {:>10}",
             i + 1,
             m.freq_hz,
             squeal_analysis::num::sci(m.re, 6),
             squeal_analysis::num::sci(m.dvr, 4),
-            if m.unstable { "YES" } else { "" },
+            match m.stability {
+                "unstable" => "UNSTABLE",
+                other => other,
+            },
+            sci(m.re_bound),
             m.backward_error,
             sci(m.cond),
             sci(m.error_bound)
         );
     }
+    println!(
+        "{} unstable, {} neutral (within their bound), {} stable{}",
+        r.unstable,
+        r.neutral,
+        r.stable,
+        if r.dvr_margin > 0.0 {
+            format!(
+                " (unstable also needs DvR > {:e}, the --dvr-margin)",
+                r.dvr_margin
+            )
+        } else {
+            String::new()
+        }
+    );
     if r.modes.iter().any(|m| m.cond.is_nan()) {
         println!(
-            "cond, err bound: not computed at full order above 1000 DOFs (--condition computes them)"
+            "cond, err bound: `-` where the class does not depend on them (full order above \
+             1000 DOFs; --condition computes them for every mode); Re bound `-`: the sign \
+             decided"
         );
     }
     for n in &r.notes {

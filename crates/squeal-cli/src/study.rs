@@ -197,7 +197,7 @@ fn solve_spec(o: &StudyOpts, scene: &squeal_scene::Scene) -> Result<SolveSpec> {
         modal: squeal_analysis::pipeline::MODAL_SOLVER.into(),
         band_hz: m.band_of(scene)?,
         tol: m.tol,
-        dvr_tol: m.dvr_tol,
+        dvr_margin: m.dvr_margin,
         classes_hz: parse_list("--classes", &o.classes)?,
         class_width: o.class_width,
     };

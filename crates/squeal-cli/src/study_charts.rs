@@ -75,7 +75,6 @@ fn macro_charts(
 ) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     let face = def.grid.face_m;
-    let tol = def.solve.dvr_tol;
     // Figure 12: modes against a at fixed b, the zone nearest the face centre per a
     for &mu in mus {
         for &b in bs {
@@ -103,12 +102,13 @@ fn macro_charts(
                 ("dvr", "DvR = Re(lambda)/Im(lambda)", 1),
             ] {
                 let mut pts = Vec::new();
-                let mut hi = Vec::new();
+                let (mut hi, mut ne) = (Vec::new(), Vec::new());
                 for r in by_a.values() {
                     let a = r.rectangle().unwrap_or_default()[2] * 1e3;
                     for m in &r.modes {
                         pts.push((a, m[pick]));
-                        hi.push(m[1] > tol);
+                        hi.push(r.unstable.iter().any(|u| u.freq_hz == m[0]));
+                        ne.push(r.neutral.iter().any(|n| n[0] == m[0]));
                     }
                 }
                 if pts.is_empty() {
@@ -117,7 +117,7 @@ fn macro_charts(
                 files.extend(line_chart(
                     &dir.join(format!("{what}_vs_a_mu{}_b{}mm", tag(mu), tag(b * 1e3))),
                     &format!(
-                        "Modes vs zone length a (b = {:.1} mm, mu = {mu}; unstable in red)",
+                        "Modes vs zone length a (b = {:.1} mm, mu = {mu}; unstable in red, neutral ringed)",
                         b * 1e3
                     ),
                     "zone length a along sliding (mm)",
@@ -126,10 +126,12 @@ fn macro_charts(
                         name: String::new(),
                         points: pts,
                         style: SeriesStyle::Markers,
+                        neutral: ne,
                         highlight: hi,
                     }],
                     &ChartOptions {
                         highlight_label: Some("unstable".into()),
+                        neutral_label: Some(crate::sweep_charts::NEUTRAL_LABEL.into()),
                         hline: (pick == 1).then_some(0.0),
                         ..ChartOptions::default()
                     },
@@ -198,6 +200,7 @@ fn macro_charts(
                 .flat_map(|r| r.unstable.iter().map(|m| (r.case.area_m2 * 1e6, m.freq_hz)))
                 .collect(),
             style: SeriesStyle::Markers,
+            neutral: Vec::new(),
             highlight: Vec::new(),
         })
         .collect();
@@ -255,6 +258,7 @@ fn unstable_vs_patch(
             name: format!("mu = {mu}, any unstable mode"),
             points: frac(&|r| !r.unstable.is_empty()),
             style: SeriesStyle::LineMarkers,
+            neutral: Vec::new(),
             highlight: Vec::new(),
         });
         for &c in &def.solve.classes_hz {
@@ -264,6 +268,7 @@ fn unstable_vs_patch(
                     name: format!("mu = {mu}, {}", classes_label(def, c)),
                     points: pts,
                     style: SeriesStyle::LineMarkers,
+                    neutral: Vec::new(),
                     highlight: Vec::new(),
                 });
             }
@@ -294,6 +299,7 @@ fn dvr_vs_freq(dir: &Path, patches: &[f64], recs: &[&Record]) -> Result<Vec<Path
                 .flat_map(|r| r.unstable.iter().map(|m| (m.freq_hz, m.dvr)))
                 .collect(),
             style: SeriesStyle::Markers,
+            neutral: Vec::new(),
             highlight: Vec::new(),
         })
         .collect();

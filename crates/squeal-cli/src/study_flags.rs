@@ -16,7 +16,7 @@ const FLAGS: [(&str, &str); 21] = [
     ("study.layouts", "--layouts"),
     ("study.fraction", "--fraction"),
     ("solve.band_hz", "--band"),
-    ("solve.dvr_tol", "--dvr-tol"),
+    ("solve.dvr_margin", "--dvr-margin"),
     ("solve.tol", "--tol"),
     ("solve.classes_hz", "--classes"),
     ("solve.class_width", "--class-width"),
@@ -85,8 +85,11 @@ mod tests {
             "--out: x already holds results: set --resume to continue"
         );
         assert_eq!(
-            input("solve.dvr_tol", "expected solve.tol and solve.dvr_tol > 0"),
-            "--dvr-tol: expected --tol and --dvr-tol > 0"
+            input(
+                "solve.dvr_margin",
+                "expected solve.tol and solve.dvr_margin > 0"
+            ),
+            "--dvr-margin: expected --tol and --dvr-margin > 0"
         );
         // a field of the scene file is not an option
         assert_eq!(

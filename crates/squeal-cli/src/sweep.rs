@@ -110,7 +110,7 @@ impl MuArgs {
             basis_opts: &self.method.basis_opt,
             band,
             contact: &self.contact,
-            dvr_tol: self.method.dvr_tol,
+            dvr_margin: self.method.dvr_margin,
             tol: self.method.tol,
             condition: self.condition,
             resume: self.resume,
@@ -194,7 +194,7 @@ impl ParamArgs {
             eigen: self.method.eigen(),
             band_hz: self.method.band(crate::opts::OPERATOR_BAND_HZ)?,
             tol: self.method.tol,
-            dvr_tol: self.method.dvr_tol,
+            dvr_margin: self.method.dvr_margin,
             condition: self.condition,
         };
         let name = self.param.as_str();
@@ -202,7 +202,7 @@ impl ParamArgs {
         let family_op = crate::opts::read_parametric(dir, name, &format!("--param {name}"))?;
         let out = &self.out;
         crate::opts::set_resume_hint(out);
-        let dvr_tol = settings.dvr_tol;
+        let dvr_margin = settings.dvr_margin;
         let mut eta = crate::opts::Eta::new(0, 0);
         let (summary, sweep) = squeal_analysis::param_sweep::run_into(
             registry,
@@ -223,13 +223,15 @@ impl ParamArgs {
                     }
                 }
                 SweepEvent::Point(p) => {
-                    let unstable = p.modes.iter().filter(|m| m.dvr > dvr_tol).count();
+                    let [unstable, neutral, _] = p.class_counts(dvr_margin);
                     eprintln!(
-                        "{} {name} {}: {} modes, {} unstable, max error bound {}, solve {:.2} s",
+                        "{} {name} {}: {} modes, {} unstable, {} neutral, max error bound {}, \
+                         solve {:.2} s",
                         eta.tick(),
                         p.value,
                         p.modes.len(),
                         unstable,
+                        neutral,
                         crate::stability::sci(squeal_analysis::sweep::files::worst(
                             &p.modes.iter().map(|m| m.error_bound).collect::<Vec<_>>()
                         )),
@@ -250,7 +252,7 @@ impl ParamArgs {
             e => crate::opts::out_error(e),
         })?;
         let axis = crate::sweep_charts::Axis::param(name);
-        crate::sweep_charts::charts(out, &axis, &sweep.points, &sweep.branches, dvr_tol)?;
+        crate::sweep_charts::charts(out, &axis, &sweep.points, &sweep.branches, dvr_margin)?;
         crate::sweep_charts::mac_charts(out, &axis, &sweep.couplings)?;
         println!(
             "{} points of {name} at mu = {}, {} couplings, max backward error {:.1e}, max \
@@ -283,8 +285,8 @@ fn print_couplings<'a>(
 ) {
     for (freq_hz, from, to, max_dvr, partners) in couplings {
         println!(
-            "  {freq_hz:>8.1} Hz  {name} {from}-{to}  max DvR {max_dvr:.4}  partners \
-             {partners:?}"
+            "  {freq_hz:>8.1} Hz  {name} {from}-{to}  max DvR {}  partners {partners:?}",
+            squeal_analysis::num::sci(max_dvr, 3)
         );
     }
     println!(
@@ -306,7 +308,7 @@ pub struct Args<'a> {
     pub band: Option<[f64; 2]>,
     /// Equilibrium solver, contact law and its parameters.
     pub contact: &'a crate::opts::ContactArgs,
-    pub dvr_tol: f64,
+    pub dvr_margin: f64,
     pub tol: f64,
     /// Condition numbers of full-order modes above the solvers' automatic size.
     pub condition: bool,
@@ -335,7 +337,7 @@ pub fn run(registry: &Registry, a: &Args<'_>) -> Result<SweepSummary> {
         equilibrium: a.contact.equilibrium.clone(),
         law: a.contact.law.clone(),
         law_params: a.contact.law_params()?,
-        dvr_tol: a.dvr_tol,
+        dvr_margin: a.dvr_margin,
         tol: a.tol,
         condition: a.condition,
         ..MuSweepSettings::new(mus, a.basis, band)
@@ -365,13 +367,13 @@ pub fn run_on(
     setup: &Profile,
 ) -> Result<(SweepSummary, MuSweep)> {
     crate::opts::set_resume_hint(out);
-    let dvr_tol = settings.dvr_tol;
+    let dvr_margin = settings.dvr_margin;
     let mut eta = crate::opts::Eta::new(settings.mus.len(), 0);
     let (summary, sweep) = run_into(registry, prep, settings, range, out, resume, setup, |e| {
-        report_event(&mut eta, out, prep, dvr_tol, e)
+        report_event(&mut eta, out, prep, dvr_margin, e)
     })
     .map_err(crate::opts::out_error)?;
-    crate::sweep_charts::sweep_charts(out, &sweep, dvr_tol)?;
+    crate::sweep_charts::sweep_charts(out, &sweep, dvr_margin)?;
     let profile = Profile {
         stages: summary.stages.clone(),
     };
@@ -388,7 +390,7 @@ pub fn report_event(
     eta: &mut crate::opts::Eta,
     out: &Path,
     prep: &Prepared,
-    dvr_tol: f64,
+    dvr_margin: f64,
     event: SweepEvent<'_>,
 ) {
     match event {
@@ -410,13 +412,14 @@ pub fn report_event(
             }
         }
         SweepEvent::Point(p) => {
-            let unstable = p.modes.iter().filter(|m| m.dvr > dvr_tol).count();
+            let [unstable, neutral, _] = p.class_counts(dvr_margin);
             eprintln!(
-                "{} mu {:.3}: {} modes, {} unstable, {} active pairs{}, solve {:.2} s",
+                "{} mu {:.3}: {} modes, {} unstable, {} neutral, {} active pairs{}, solve {:.2} s",
                 eta.tick(),
                 p.mu,
                 p.modes.len(),
                 unstable,
+                neutral,
                 p.active_pairs,
                 if p.rebuilt { " (new contact set)" } else { "" },
                 p.times_s[2]

@@ -6,12 +6,17 @@ use anyhow::Result;
 use squeal_analysis::family::SweepCoupling;
 use squeal_analysis::mu_sweep::MuSweep;
 use squeal_analysis::sweep::{Branch, SweepPoint};
+use squeal_core::Stability;
 use std::path::{Path, PathBuf};
+
+/// Legend entry of the modes whose stability the solve cannot tell within their error
+/// bound (ringed in the charts).
+pub const NEUTRAL_LABEL: &str = "neutral within the error bound";
 
 /// The charts of a finished mu sweep: frequency and DvR against mu (Figure 5), and the
 /// make-up of each coupling.
-pub fn sweep_charts(out: &Path, sweep: &MuSweep, dvr_tol: f64) -> Result<()> {
-    charts(out, &Axis::mu(), &sweep.points, &sweep.branches, dvr_tol)?;
+pub fn sweep_charts(out: &Path, sweep: &MuSweep, dvr_margin: f64) -> Result<()> {
+    charts(out, &Axis::mu(), &sweep.points, &sweep.branches, dvr_margin)?;
     let makeup: Vec<SweepCoupling> = sweep
         .couplings
         .iter()
@@ -79,9 +84,13 @@ pub fn charts(
                         .map(|&(p, m)| (points[p].value, y(&points[p].modes[m])))
                         .collect(),
                     style: SeriesStyle::LineMarkers,
+                    neutral: pts
+                        .iter()
+                        .map(|&(p, m)| points[p].modes[m].stability(tol) == Stability::Neutral)
+                        .collect(),
                     highlight: pts
                         .iter()
-                        .map(|&(p, m)| points[p].modes[m].dvr > tol)
+                        .map(|&(p, m)| points[p].modes[m].stability(tol) == Stability::Unstable)
                         .collect(),
                 }
             })
@@ -89,24 +98,26 @@ pub fn charts(
     };
     let mut files = line_chart(
         &out.join(format!("frequency_vs_{}", axis.column)),
-        "Frequency of the tracked modes (unstable in red)",
+        "Frequency of the tracked modes (unstable in red, neutral ringed)",
         &axis.label,
         "frequency (Hz)",
         &series(&|m| m.freq_hz),
         &ChartOptions {
             highlight_label: Some("unstable".into()),
+            neutral_label: Some(NEUTRAL_LABEL.into()),
             ..ChartOptions::default()
         },
     )?;
     files.extend(line_chart(
         &out.join(format!("dvr_vs_{}", axis.column)),
-        "Divergence rate Re/Im of the tracked modes (unstable in red)",
+        "Divergence rate Re/Im of the tracked modes (unstable in red, neutral ringed)",
         &axis.label,
         "DvR = Re(lambda)/Im(lambda)",
         &series(&|m| m.dvr),
         &ChartOptions {
             hline: Some(0.0),
             highlight_label: Some("unstable".into()),
+            neutral_label: Some(NEUTRAL_LABEL.into()),
             ..ChartOptions::default()
         },
     )?);

@@ -104,6 +104,7 @@ pub fn build_operator(
         fk: friction(k)?,
         t: Some(t),
         friction_loads: Some(friction_loads),
+        modal: Default::default(),
     })
 }
 

@@ -59,7 +59,8 @@ impl FrictionalOperator {
 
     /// An operator given directly by its parts in another sparse type, each converted by
     /// `f` (e.g. `interop::from_nalgebra`, `interop::from_sprs`); no index map and no friction load
-    /// directions (as an operator read from files). The parts must be square, of one
+    /// directions (as an operator read from files), real modes from the symmetric parts of
+    /// `K_c` and `M_c` ([`crate::operator::RealModePair::Lazy`]). The parts must be square, of one
     /// size, with a damping friction part only beside a damping.
     pub fn from_parts_with<S>(
         parts: OperatorParts<S>,
@@ -101,6 +102,11 @@ impl FrictionalOperator {
             fk: p.fk,
             t: None,
             friction_loads: None,
+            modal: crate::operator::RealModePair::lazy(
+                None,
+                None,
+                "symmetric parts of K_c and M_c (an operator given by its parts)",
+            ),
         })
     }
 }

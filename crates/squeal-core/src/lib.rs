@@ -50,7 +50,9 @@ pub use eigen::{
 pub use error::{Error, Result};
 pub use lowrank::{FrictionLowRank, SymmetricPencil, SymmetricShift, Woodbury};
 pub use material::{Material, Voigt6};
-pub use operator::{ComplexModes, FrictionalOperator, Qep, RealModes, SolveInfo, StopReason};
+pub use operator::{
+    ComplexModes, FrictionalOperator, Qep, RealModes, SolveInfo, Stability, StopReason, Verdict,
+};
 pub use params::{ParamValue, Params};
 pub use qep::{
     dense_qep, solve_frictional_band, solve_qep_band, ComplexKernel, ComplexKernelOutput,

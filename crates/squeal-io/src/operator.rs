@@ -4,6 +4,7 @@
 use crate::mtx::{check_finite, io_err, read_mtx, read_square_with, write_mtx};
 use crate::IoError;
 use faer::sparse::SymbolicSparseColMat;
+use squeal_core::operator::RealModePair;
 use squeal_core::{FrictionalOperator, SparseMat};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -136,6 +137,14 @@ pub fn read_operator_dir(dir: impl AsRef<Path>) -> Result<FrictionalOperator, Io
         fk,
         t,
         friction_loads,
+        modal: RealModePair::lazy(
+            None,
+            None,
+            format!(
+                "symmetric parts of {FILE_KC} and {FILE_MC} in {}",
+                dir.display()
+            ),
+        ),
     })
 }
 

@@ -69,6 +69,7 @@ fn hoffmann() -> FrictionalOperator {
         fk: mat(2, &[(0, 1, 1.0)]),
         t: None,
         friction_loads: None,
+        modal: Default::default(),
     }
 }
 
@@ -201,6 +202,7 @@ fn full_operator() -> FrictionalOperator {
             )
             .unwrap(),
         ),
+        modal: Default::default(),
     }
 }
 

@@ -71,6 +71,7 @@ fn main() -> Result<(), PlotError> {
         name: "modes (mu = 0 .. 0.5)".into(),
         points: modes,
         style: SeriesStyle::Markers,
+        neutral: Vec::new(),
         highlight,
     };
     files.extend(line_chart(
@@ -93,6 +94,7 @@ fn main() -> Result<(), PlotError> {
             .map(|i| (i as f64, (-(rate * i as f64)).exp() + 1e-15))
             .collect(),
         style: SeriesStyle::LineMarkers,
+        neutral: Vec::new(),
         highlight: Vec::new(),
     };
     files.extend(line_chart(

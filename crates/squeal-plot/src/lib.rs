@@ -19,6 +19,7 @@
 //!     points: vec![(1200.0, -3.0), (2400.0, 0.0), (5100.0, 12.5)],
 //!     style: SeriesStyle::Markers,
 //!     highlight: vec![false, false, true], // unstable modes in red
+//!     neutral: vec![false, true, false],   // neutral within the error bound: a ring
 //! };
 //! let opts = ChartOptions { hline: Some(0.0), ..ChartOptions::default() };
 //! let files = line_chart(
@@ -315,6 +316,9 @@ pub(crate) fn series_marker(k: usize, r: i32) -> Vec<(i32, i32)> {
 
 /// Colour of highlighted points (unstable modes, Pareto front).
 pub(crate) const HIGHLIGHT: RGBColor = RGBColor(214, 39, 40);
+
+/// Colour of the ring of neutral points (modes within their error bound).
+pub(crate) const NEUTRAL: RGBColor = RGBColor(255, 140, 0);
 
 pub(crate) fn title_font() -> TextStyle<'static> {
     font(24)

@@ -9,7 +9,7 @@ use plotters::prelude::*;
 
 use crate::{
     auto_linear, auto_log, check_range, font, render, series_colour, series_marker, tick_in,
-    title_font, with_axes, Figure, PlotError, CHART_SIZE, HIGHLIGHT,
+    title_font, with_axes, Figure, PlotError, CHART_SIZE, HIGHLIGHT, NEUTRAL,
 };
 
 /// How a [`Series`] is drawn.
@@ -37,6 +37,10 @@ pub struct Series {
     /// as bigger red circles (whatever the style), e.g. the unstable modes of a
     /// stability map.
     pub highlight: Vec<bool>,
+    /// Neutral mask, one flag per point, or empty for none. Marked points get a ring in
+    /// the neutral colour (whatever the style), e.g. the modes whose stability the solve
+    /// cannot decide within their error bound.
+    pub neutral: Vec<bool>,
 }
 
 /// Options of a [`line_chart`]. `ChartOptions::default()` gives linear axes with
@@ -57,6 +61,9 @@ pub struct ChartOptions {
     pub hline: Option<f64>,
     /// Legend entry for highlighted points (e.g. `"unstable"`); `None` for no entry.
     pub highlight_label: Option<String>,
+    /// Legend entry for neutral points (e.g. `"neutral within the error bound"`); `None`
+    /// for no entry.
+    pub neutral_label: Option<String>,
     /// Image size in pixels (width, height), for both the SVG and the PNG.
     pub size: (u32, u32),
 }
@@ -70,6 +77,7 @@ impl Default for ChartOptions {
             y_range: None,
             hline: None,
             highlight_label: None,
+            neutral_label: None,
             size: CHART_SIZE,
         }
     }
@@ -129,11 +137,31 @@ pub fn line_chart(
                 ),
             ));
         }
-        let pts: Vec<((f64, f64), bool)> = s
+        if !s.neutral.is_empty() && s.neutral.len() != s.points.len() {
+            return Err(PlotError::invalid(
+                stem,
+                format!(
+                    "series {k} ({:?}): {} neutral flags for {} points",
+                    s.name,
+                    s.neutral.len(),
+                    s.points.len()
+                ),
+            ));
+        }
+        let pts: Vec<((f64, f64), Mark)> = s
             .points
             .iter()
             .enumerate()
-            .map(|(i, p)| (*p, s.highlight.get(i).copied().unwrap_or(false)))
+            .map(|(i, p)| {
+                let mark = if s.highlight.get(i).copied().unwrap_or(false) {
+                    Mark::Highlight
+                } else if s.neutral.get(i).copied().unwrap_or(false) {
+                    Mark::Neutral
+                } else {
+                    Mark::None
+                };
+                (*p, mark)
+            })
             .filter(|((x, y), _)| (!opts.log_x || *x > 0.0) && (!opts.log_y || *y > 0.0))
             .collect();
         kept.push(pts);
@@ -182,13 +210,21 @@ fn auto(vals: impl Iterator<Item = f64>, log: bool) -> Range<f64> {
     r.unwrap_or(if log { 0.1..10.0 } else { -1.0..1.0 })
 }
 
+/// How a point is marked on top of its series.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mark {
+    None,
+    Highlight,
+    Neutral,
+}
+
 struct LineFig<'a> {
     title: &'a str,
     x_label: &'a str,
     y_label: &'a str,
     series: &'a [Series],
-    /// Points left after dropping those a log axis cannot show, with their highlight flag.
-    kept: Vec<Vec<((f64, f64), bool)>>,
+    /// Points left after dropping those a log axis cannot show, with their mark.
+    kept: Vec<Vec<((f64, f64), Mark)>>,
     hline: Option<f64>,
     opts: &'a ChartOptions,
     xr: Range<f64>,
@@ -272,7 +308,9 @@ impl LineFig<'_> {
                 ))?;
                 add_label(ann);
             }
-            let normal = pts.iter().filter(|(p, h)| marks && !h && inside(p));
+            let normal = pts
+                .iter()
+                .filter(|(p, h)| marks && *h != Mark::Highlight && inside(p));
             // circles for the first nine series, then the other shapes of
             // `series_marker`, so light/dark partner colours also differ in shape
             let ann = if k < 9 {
@@ -284,14 +322,26 @@ impl LineFig<'_> {
             };
             add_label(ann);
         }
-        // Highlighted points last, on top of every series.
-        let hl: Vec<(f64, f64)> = self
-            .kept
-            .iter()
-            .flatten()
-            .filter(|(p, h)| *h && inside(p))
-            .map(|(p, _)| *p)
-            .collect();
+        // Neutral rings, then highlighted points last, on top of every series.
+        let marked = |m: Mark| -> Vec<(f64, f64)> {
+            self.kept
+                .iter()
+                .flatten()
+                .filter(|(p, h)| *h == m && inside(p))
+                .map(|(p, _)| *p)
+                .collect()
+        };
+        let nl = marked(Mark::Neutral);
+        let ann = chart.draw_series(
+            nl.iter()
+                .map(|p| Circle::new(*p, 6, NEUTRAL.stroke_width(2))),
+        )?;
+        if let (Some(label), false) = (&self.opts.neutral_label, nl.is_empty()) {
+            ann.label(label.clone())
+                .legend(|(x, y)| Circle::new((x + 7, y), 5, NEUTRAL.stroke_width(2)));
+            legend = true;
+        }
+        let hl = marked(Mark::Highlight);
         let ann = chart.draw_series(hl.iter().map(|p| Circle::new(*p, 5, HIGHLIGHT.filled())))?;
         if let (Some(label), false) = (&self.opts.highlight_label, hl.is_empty()) {
             ann.label(label.clone())

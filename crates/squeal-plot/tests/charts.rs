@@ -346,6 +346,7 @@ fn modes() -> Series {
             (5000.0, -3.0),
         ],
         style: SeriesStyle::Markers,
+        neutral: Vec::new(),
         highlight: vec![false, false, true, true, false],
     }
 }
@@ -355,6 +356,7 @@ fn curve() -> Series {
         name: "fit".into(),
         points: vec![(1000.0, -1.5), (2500.0, 0.0), (4000.0, 1.0), (5000.0, 2.0)],
         style: SeriesStyle::Line,
+        neutral: Vec::new(),
         highlight: vec![],
     }
 }
@@ -406,6 +408,7 @@ fn line_chart_custom_size_and_line_markers() {
         name: String::new(), // no legend
         points: (0..8).map(|i| (i as f64, 10f64.powi(-i))).collect(),
         style: SeriesStyle::LineMarkers,
+        neutral: Vec::new(),
         highlight: vec![],
     };
     let opts = ChartOptions {
@@ -435,6 +438,7 @@ fn line_chart_log_axes_drop_non_positive_points() {
             (1e3, -2.0),
         ],
         style: SeriesStyle::Markers,
+        neutral: Vec::new(),
         highlight: vec![false, true, false, false, true],
     };
     let opts = ChartOptions {
@@ -459,6 +463,7 @@ fn line_chart_log_axes_drop_non_positive_points() {
     // Nothing positive left: empty.
     let bad = Series {
         points: vec![(0.0, 1.0), (-3.0, 2.0)],
+        neutral: Vec::new(),
         highlight: vec![],
         ..s
     };

@@ -16,6 +16,12 @@
 //! the shared reduced solve then refines them and gives every mode its backward error on
 //! the full operator.
 //!
+//! An operator read from files has no free model and no pairs: there the synthesis takes
+//! the operator's friction load directions as its interface (free-interface modes of its
+//! real-mode pair, attachment modes of the friction loads, the frictional operator solved
+//! on them; module `loads`), and an operator without friction loads is refused with what
+//! to add.
+//!
 //! The synthesis is undamped (a damped operator is still projected whole); the basis
 //! depends on mu ([`ReductionBasis::depends_on_mu`] is `true`): it is rebuilt at every mu,
 //! which costs far less than one real-mode solve.
@@ -49,6 +55,7 @@ use squeal_core::{
 use std::sync::Arc;
 use std::time::Instant;
 
+mod loads;
 pub mod synthesis;
 
 pub use synthesis::{FreeInterface, Synthesized};
@@ -185,17 +192,20 @@ impl ReductionBasis for CmsBasis {
     }
 
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {
-        let free = request
-            .stage
-            .and_then(|s| s.downcast_ref::<FreeInterface>())
-            .ok_or_else(|| {
-                Error::Invalid(
-                    "the `cms` basis needs the free-interface synthesis of the model, which \
-                     the scene-based commands (stability, sweep, studies, bench with a \
-                     scene) build; an operator read from files has none"
-                        .into(),
-                )
-            })?;
+        let Some(stage) = request.stage else {
+            if request.op.t.is_none() {
+                return loads::build_on_loads(self, request);
+            }
+            return Err(Error::Invalid(
+                "the `cms` basis needs the free-interface synthesis of the model, which the \
+                 scene-based commands (stability, sweep, studies, bench with a scene) build \
+                 in their model stage; none was given for this contact set"
+                    .into(),
+            ));
+        };
+        let free = stage.downcast_ref::<FreeInterface>().ok_or_else(|| {
+            Error::Invalid("cms: the model stage is not a free-interface synthesis".into())
+        })?;
         let op = request.op;
         let active = free.active_in(op)?;
         let clock = Instant::now();

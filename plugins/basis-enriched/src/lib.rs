@@ -176,7 +176,11 @@ impl ReductionBasis for EnrichedBasis {
         let t_statics = clock.elapsed().as_secs_f64();
         // a factor of its own is the largest allocation here: freed before the
         // orthonormalization
-        let method = std::mem::take(&mut ks.method);
+        let mut method = std::mem::take(&mut ks.method);
+        if !ks.is_own() {
+            method += "; static responses K_c^-1 U by a sparse LU of the operator's own \
+                       (non-symmetric) K_c";
+        }
         drop(ks);
         let finite = (0..statics.ncols())
             .all(|c| norm2(statics.col(c).try_as_col_major().unwrap().as_slice()).is_finite());

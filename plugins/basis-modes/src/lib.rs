@@ -1,7 +1,9 @@
 //! # squeal-basis-modes
 //!
 //! The real-mode reduction basis, registered as `"modes"`: the coupled mu = 0 modes of
-//! `(K_c, M_c)` from 0 Hz up to `cutoff_factor x` the band top, `M_c`-orthonormal — the
+//! `(K_c, M_c)` (of the operator's real-mode pair,
+//! [`squeal_core::reduction::real_mode_pair`], for an operator read from files) from 0 Hz
+//! up to `cutoff_factor x` the band top, `M_c`-orthonormal — the
 //! projection commercial codes use (QRDAMP-style), the baseline of the comparison.
 //! Truncated near the band top it misses the friction-induced deformation and
 //! over-predicts growth rates (METHODS.md section 4); the backward errors of the
@@ -19,7 +21,9 @@
 //!   `M_c`-orthonormalization.
 
 use squeal_core::params::{fraction, positive};
-use squeal_core::reduction::{coupled_real_modes, m_orthonormalize, DEFAULT_RANK_TOL};
+use squeal_core::reduction::{
+    coupled_real_modes, m_orthonormalize, real_mode_pair, DEFAULT_RANK_TOL,
+};
 use squeal_core::{Basis, BasisRequest, Params, ReductionBasis, Registry, Result};
 
 /// Name under which the basis is registered.
@@ -79,11 +83,17 @@ impl ReductionBasis for ModesBasis {
         )?;
         let mut basis = Basis::new(v);
         basis.dropped = dropped;
+        let pair = real_mode_pair(request.op)?;
         basis.notes.push(format!(
-            "{NAME}: {} coupled mu = 0 real modes up to {cutoff:.1} Hz (`{}`, {:.3} s)",
+            "{NAME}: {} coupled mu = 0 real modes up to {cutoff:.1} Hz (`{}`, {:.3} s){}",
             modes.freq_hz.len(),
             request.modal.name(),
-            modes.info.time_s
+            modes.info.time_s,
+            if pair.own {
+                String::new()
+            } else {
+                format!(" of the real-mode pair ({})", pair.source)
+            }
         ));
         Ok(basis)
     }

@@ -84,6 +84,7 @@ fn hoffmann() -> FrictionalOperator {
         fk: sparse(2, &[(0, 1, 1.0)]),
         t: None,
         friction_loads: None,
+        modal: Default::default(),
     }
 }
 

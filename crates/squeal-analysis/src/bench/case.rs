@@ -7,7 +7,7 @@ use crate::pipeline::{PipelineError, Result};
 use crate::profile::max_opt;
 use serde::{Deserialize, Serialize};
 use squeal_core::contact::BasisRequest;
-use squeal_core::operator::ComplexModes;
+use squeal_core::operator::{ComplexModes, Stability};
 use squeal_core::reduction::ReducedOperator;
 use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Params, Registry};
 use std::time::Instant;
@@ -50,6 +50,10 @@ pub struct BenchRun {
     pub condition_s: Option<f64>,
     /// Basis size (0 for full order).
     pub basis_size: usize,
+    /// What the basis says of itself (its columns, the real-mode pair it drew them from,
+    /// its steps); empty for full order.
+    #[serde(default)]
+    pub basis_notes: Vec<String>,
     /// DOFs of the (constrained) operator.
     pub dofs: usize,
     /// Eigen solver tolerance.
@@ -88,6 +92,10 @@ pub struct ReferenceSolve {
     pub modes: usize,
     /// Unstable modes `[freq_hz, dvr]`.
     pub unstable: Vec<[f64; 2]>,
+    /// Modes neutral within their error bound `[freq_hz, dvr]` (the physical margin
+    /// applied as for `unstable`).
+    #[serde(default)]
+    pub neutral: Vec<[f64; 2]>,
     /// Worst backward error in the band.
     #[serde(deserialize_with = "null_as_nan")]
     pub max_backward_error: f64,
@@ -171,8 +179,16 @@ pub fn bench_case(
     let ref_time = t.elapsed().as_secs_f64();
     let ref_condition_s = with_condition(opts, op, mu, &mut reference)?;
     let ref_peak = meter.peak_mb();
-    let self_errors = compare(&reference, &reference, opts.band_hz, opts.dvr_tol);
+    let self_errors = compare(&reference, &reference, opts.band_hz, opts.dvr_margin);
     let in_band = |f: f64| f >= opts.band_hz[0] && f <= opts.band_hz[1];
+    let of_class = |class: Stability| -> Vec<[f64; 2]> {
+        (0..reference.len())
+            .filter(|&i| {
+                in_band(reference.freq_hz[i]) && reference.stability(i, opts.dvr_margin) == class
+            })
+            .map(|i| [reference.freq_hz[i], reference.dvr[i]])
+            .collect()
+    };
     let ref_out = ReferenceSolve {
         case: case.into(),
         mu,
@@ -182,10 +198,8 @@ pub fn bench_case(
         time_s: ref_time,
         peak_mb: ref_peak,
         modes: self_errors.reference_modes,
-        unstable: (0..reference.len())
-            .filter(|&i| in_band(reference.freq_hz[i]) && reference.is_unstable(i, opts.dvr_tol))
-            .map(|i| [reference.freq_hz[i], reference.dvr[i]])
-            .collect(),
+        unstable: of_class(Stability::Unstable),
+        neutral: of_class(Stability::Neutral),
         max_backward_error: self_errors.max_backward_error,
         max_error_bound: self_errors.max_error_bound,
     };
@@ -266,6 +280,7 @@ impl Runner<'_> {
             peak_mb: None,
             condition_s: None,
             basis_size: 0,
+            basis_notes: Vec::new(),
             dofs: self.op.dim(),
             tol: self.opts.tol,
             errors: ModeErrors::failed(),
@@ -290,7 +305,7 @@ impl Runner<'_> {
                 match with_condition(opts, op, mu, &mut modes) {
                     Ok(c) => {
                         run.condition_s = c;
-                        run.errors = compare(self.reference, &modes, opts.band_hz, opts.dvr_tol);
+                        run.errors = compare(self.reference, &modes, opts.band_hz, opts.dvr_margin);
                     }
                     Err(e) => run.status = format!("error: {e}"),
                 }
@@ -363,6 +378,7 @@ impl Runner<'_> {
             let mut run = BenchRun {
                 setup_s,
                 basis_size: red.basis.len(),
+                basis_notes: red.basis.notes.clone(),
                 ..self.blank(basis, label, eigen)
             };
             let t = Instant::now();
@@ -374,7 +390,7 @@ impl Runner<'_> {
                     run.solve_s = t.elapsed().as_secs_f64();
                     run.reduced_solve_s = Some(r.solve_time_s);
                     run.expansion_s = Some(r.expansion_time_s);
-                    run.errors = compare(self.reference, &r.modes, opts.band_hz, opts.dvr_tol);
+                    run.errors = compare(self.reference, &r.modes, opts.band_hz, opts.dvr_margin);
                 }
                 Err(e) => {
                     run.solve_s = t.elapsed().as_secs_f64();

@@ -3,7 +3,7 @@
 
 use crate::jsonl::{nan, null_as_nan};
 use serde::{Deserialize, Serialize};
-use squeal_core::operator::ComplexModes;
+use squeal_core::operator::{ComplexModes, Stability};
 
 /// When a run counts as accurate: every reference mode in the band found, no missed or
 /// false unstable mode, and the errors below these bounds.
@@ -41,10 +41,17 @@ pub struct ModeErrors {
     pub max_abs_dvr_err: f64,
     /// Unstable reference modes.
     pub reference_unstable: usize,
-    /// Unstable reference modes without an unstable partner.
+    /// Reference modes neutral within their error bound.
+    #[serde(default)]
+    pub reference_neutral: usize,
+    /// Unstable reference modes without an unstable partner (a partner neutral within
+    /// its bound is a miss too: the method could not tell).
     pub missed_unstable: usize,
-    /// Unstable modes in the band whose partner is stable, or without partner.
+    /// Unstable modes in the band whose partner is not unstable, or without partner.
     pub false_unstable: usize,
+    /// Modes in the band the method leaves neutral within their error bound.
+    #[serde(default)]
+    pub neutral: usize,
     /// Worst backward error (on the full operator) of the modes in the band.
     #[serde(deserialize_with = "null_as_nan")]
     pub max_backward_error: f64,
@@ -86,8 +93,10 @@ impl ModeErrors {
             max_rel_freq_err: f64::NAN,
             max_abs_dvr_err: f64::NAN,
             reference_unstable: 0,
+            reference_neutral: 0,
             missed_unstable: 0,
             false_unstable: 0,
+            neutral: 0,
             max_backward_error: f64::NAN,
             max_error_bound: f64::NAN,
             max_cond: f64::NAN,
@@ -110,7 +119,8 @@ impl ModeErrors {
 /// matched to the nearest unused eigenvalue of `modes` within 1 % in frequency (none
 /// there: missed); modes of `modes` up to 1 % beyond the band edges may be
 /// partners (a mode at the edge may fall either side), those inside the band and matched
-/// to nothing are extra. A mode is unstable when its DvR exceeds `dvr_tol`. The worst
+/// to nothing are extra. A mode's class is [`ComplexModes::stability`] (its real part
+/// against its own error bound, and the physical margin `dvr_margin`). The worst
 /// `error_bound` and `cond` of the modes in the band are recorded next to their worst
 /// backward error, with the actual relative eigenvalue errors of the matched modes and how
 /// many exceed their own bound.
@@ -118,7 +128,7 @@ pub fn compare(
     reference: &ComplexModes,
     modes: &ComplexModes,
     band_hz: [f64; 2],
-    dvr_tol: f64,
+    dvr_margin: f64,
 ) -> ModeErrors {
     let in_band = |f: f64| f >= band_hz[0] && f <= band_hz[1];
     let near_band = |f: f64| f >= band_hz[0] * 0.99 && f <= band_hz[1] * 1.01;
@@ -133,8 +143,10 @@ pub fn compare(
     let mut matched = 0;
     for i in (0..reference.len()).filter(|&i| in_band(reference.freq_hz[i])) {
         e.reference_modes += 1;
-        let unstable_ref = reference.is_unstable(i, dvr_tol);
+        let class_ref = reference.stability(i, dvr_margin);
+        let unstable_ref = class_ref == Stability::Unstable;
         e.reference_unstable += usize::from(unstable_ref);
+        e.reference_neutral += usize::from(class_ref == Stability::Neutral);
         // the nearest eigenvalue among the unused modes within 1 % in frequency: a strongly
         // unstable mode's nearest eigenvalue can be a mode of another frequency
         let rel_df = |j: usize| {
@@ -164,7 +176,7 @@ pub fn compare(
         e.max_abs_dvr_err = e
             .max_abs_dvr_err
             .max((modes.dvr[j] - reference.dvr[i]).abs());
-        let unstable = modes.is_unstable(j, dvr_tol);
+        let unstable = modes.is_unstable(j, dvr_margin);
         if unstable_ref && !unstable {
             e.missed_unstable += 1;
         } else if unstable && !unstable_ref {
@@ -173,9 +185,10 @@ pub fn compare(
     }
     for j in (0..modes.len()).filter(|&j| in_band(modes.freq_hz[j])) {
         e.max_backward_error = e.max_backward_error.max(modes.backward_error[j]);
+        e.neutral += usize::from(modes.stability(j, dvr_margin) == Stability::Neutral);
         if !used[j] {
             e.extra_modes += 1;
-            e.false_unstable += usize::from(modes.is_unstable(j, dvr_tol));
+            e.false_unstable += usize::from(modes.is_unstable(j, dvr_margin));
         }
     }
     let band: Vec<usize> = (0..modes.len())

@@ -49,8 +49,10 @@ pub struct BenchOptions {
     pub reference_eigen: String,
     /// Its tolerance.
     pub reference_tol: f64,
-    /// A mode is unstable when its DvR = Re/Im exceeds this.
-    pub dvr_tol: f64,
+    /// Physical margin on the divergence rate: a mode counts as unstable only when its DvR
+    /// = Re/Im also exceeds this (0: its real part against its forward error bound alone
+    /// decides, `squeal_core::operator::classify`).
+    pub dvr_margin: f64,
     /// Bases to run (`none` = full order).
     pub bases: Vec<String>,
     /// Eigen solvers to run (of the reduced problem when there is a basis).
@@ -83,7 +85,7 @@ impl BenchOptions {
             tol: 1e-10,
             reference_eigen: "arpack".into(),
             reference_tol: 1e-12,
-            dvr_tol: 1e-6,
+            dvr_margin: 0.0,
             bases,
             eigens: registry.eigen.names(),
             vary: Vec::new(),

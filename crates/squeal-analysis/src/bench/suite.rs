@@ -165,8 +165,10 @@ pub struct SuiteSummary {
     pub reference_eigen: String,
     /// Its tolerance.
     pub reference_tol: f64,
-    /// A mode is unstable when its DvR exceeds this.
-    pub dvr_tol: f64,
+    /// Physical margin on the divergence rate: a mode counts as unstable only when its DvR
+    /// = Re/Im also exceeds this (0: its real part against its forward error bound alone
+    /// decides, `squeal_core::operator::classify`).
+    pub dvr_margin: f64,
     /// What counts as accurate.
     pub accuracy: Accuracy,
     /// Bases.
@@ -372,7 +374,7 @@ pub fn run_suite(
         condition: o.condition,
         reference_eigen: o.reference_eigen.clone(),
         reference_tol: o.reference_tol,
-        dvr_tol: o.dvr_tol,
+        dvr_margin: o.dvr_margin,
         accuracy: o.accuracy,
         bases: o.bases.clone(),
         eigens: o.eigens.clone(),

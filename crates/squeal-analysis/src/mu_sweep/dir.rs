@@ -36,8 +36,10 @@ pub struct SweepSummary {
     pub law_params: String,
     /// Free DOFs of the model.
     pub dofs: usize,
-    /// A mode is unstable when its DvR exceeds this.
-    pub dvr_tol: f64,
+    /// Physical margin on the divergence rate: a mode counts as unstable only when its DvR
+    /// = Re/Im also exceeds this (0: its real part against its forward error bound alone
+    /// decides, `squeal_core::operator::classify`).
+    pub dvr_margin: f64,
     /// Points of the sweep.
     pub points: usize,
     /// Points where the contact set changed (a new operator and basis).
@@ -113,7 +115,7 @@ pub fn run_into(
         "mu",
         points,
         &sweep.branches,
-        settings.dvr_tol,
+        settings.dvr_margin,
     )?;
     let mut profile = setup.clone();
     profile.extend_prefixed("", &sweep.profile);
@@ -128,7 +130,7 @@ pub fn run_into(
         law: settings.law.clone(),
         law_params: settings.law_params.to_string(),
         dofs: prep.model.dofs.n_free(),
-        dvr_tol: settings.dvr_tol,
+        dvr_margin: settings.dvr_margin,
         points: points.len(),
         rebuilds: points.iter().filter(|p| p.rebuilt).count(),
         max_basis_size: points.iter().map(|p| p.basis_size).max().unwrap_or(0),

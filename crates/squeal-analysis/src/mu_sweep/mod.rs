@@ -38,8 +38,10 @@ pub struct MuSweepSettings {
     pub law: String,
     /// The contact law's parameters (a penalty's stiffness).
     pub law_params: Params,
-    /// A mode is unstable when its DvR exceeds this.
-    pub dvr_tol: f64,
+    /// Physical margin on the divergence rate: a mode counts as unstable only when its DvR
+    /// = Re/Im also exceeds this (0: its real part against its forward error bound alone
+    /// decides, `squeal_core::operator::classify`).
+    pub dvr_margin: f64,
     /// Friction coefficients whose complex modes (with their vectors) are kept in
     /// [`MuSweep::kept`], for comparisons with full order.
     pub keep_modes_at: Vec<f64>,
@@ -51,7 +53,7 @@ pub struct MuSweepSettings {
 impl MuSweepSettings {
     /// A sweep over `mus` through `basis` (`none`: full order with `arpack`, else the
     /// reduced problem with `dense`), band `band_hz`, `lcp` equilibrium, Lagrange contact,
-    /// tolerance 1e-10, DvR threshold 1e-6.
+    /// tolerance 1e-10, no DvR margin.
     pub fn new(mus: Vec<f64>, basis: &str, band_hz: [f64; 2]) -> Self {
         Self {
             mus,
@@ -63,7 +65,7 @@ impl MuSweepSettings {
             equilibrium: "lcp".into(),
             law: "lagrange".into(),
             law_params: Params::new(),
-            dvr_tol: 1e-6,
+            dvr_margin: 0.0,
             keep_modes_at: Vec::new(),
             condition: false,
         }
@@ -200,7 +202,7 @@ pub fn run_sweep(
         &s.mus,
         &mut method,
         &free,
-        s.dvr_tol,
+        s.dvr_margin,
         &s.keep_modes_at,
         checkpoint,
         progress,

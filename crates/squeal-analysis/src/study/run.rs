@@ -9,7 +9,7 @@ use crate::pipeline::{damped_operator, Method, PipelineError};
 use crate::profile::Profile;
 use serde::{Deserialize, Serialize};
 use squeal_contact::ContactSet;
-use squeal_core::Registry;
+use squeal_core::{Registry, Stability};
 use squeal_scene::{Damping, Model};
 use std::collections::BTreeMap;
 use std::sync::Mutex;
@@ -37,8 +37,12 @@ pub struct Record {
     pub case: Case,
     /// Basis size (0 for full order).
     pub basis_size: usize,
-    /// Unstable modes (DvR above the study's threshold), by frequency.
+    /// Unstable modes (real part above its error bound, and DvR above the study's
+    /// physical margin), by frequency.
     pub unstable: Vec<UnstableMode>,
+    /// Modes neutral within their error bound, `[freq_hz, dvr]`, by frequency.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub neutral: Vec<[f64; 2]>,
     /// Every mode in the band: `[freq_hz, dvr]`, by frequency.
     pub modes: Vec<[f64; 2]>,
     /// Largest backward error of the modes.
@@ -108,6 +112,7 @@ pub fn run_case(
         case: case.clone(),
         basis_size: 0,
         unstable: Vec::new(),
+        neutral: Vec::new(),
         modes: Vec::new(),
         max_backward_error: 0.0,
         error: None,
@@ -133,13 +138,15 @@ pub fn run_case(
             let (f, d, be) = (modes.freq_hz[i], modes.dvr[i], modes.backward_error[i]);
             rec.modes.push([f, d]);
             rec.max_backward_error = rec.max_backward_error.max(be);
-            if d > solve.dvr_tol {
-                rec.unstable.push(UnstableMode {
+            match modes.stability(i, solve.dvr_margin) {
+                Stability::Unstable => rec.unstable.push(UnstableMode {
                     freq_hz: f,
                     dvr: d,
                     backward_error: be,
                     class_hz: solve.class_of(f),
-                });
+                }),
+                Stability::Neutral => rec.neutral.push([f, d]),
+                Stability::Stable => {}
             }
         }
         Ok(())

@@ -66,8 +66,11 @@ pub struct SolveSpec {
     pub band_hz: [f64; 2],
     /// Relative tolerance of the eigen solvers.
     pub tol: f64,
-    /// A mode is unstable when its DvR exceeds this.
-    pub dvr_tol: f64,
+    /// Physical margin on the divergence rate: a mode counts as unstable only when its DvR
+    /// = Re/Im also exceeds this (0: its real part against its forward error bound alone
+    /// decides, `squeal_core::operator::classify`).
+    #[serde(alias = "dvr_tol")]
+    pub dvr_margin: f64,
     /// Frequencies (Hz) that classify unstable modes: a mode belongs to the nearest
     /// class within `class_width` (relative), else to none.
     pub classes_hz: Vec<f64>,
@@ -91,10 +94,10 @@ impl SolveSpec {
                 format!("expected a tolerance in (0, 1), got {}", self.tol),
             ));
         }
-        if !(self.dvr_tol.is_finite() && self.dvr_tol >= 0.0) {
+        if !(self.dvr_margin.is_finite() && self.dvr_margin >= 0.0) {
             return Err(input(
-                "solve.dvr_tol",
-                format!("expected a DvR threshold >= 0, got {}", self.dvr_tol),
+                "solve.dvr_margin",
+                format!("expected a DvR margin >= 0, got {}", self.dvr_margin),
             ));
         }
         if self.classes_hz.is_empty()

@@ -103,6 +103,10 @@ pub struct Summary {
     pub failed: usize,
     /// Cases with at least one unstable mode.
     pub unstable_cases: usize,
+    /// Cases with at least one mode neutral within its error bound (whose stability the
+    /// solve could not tell).
+    #[serde(default)]
+    pub neutral_cases: usize,
     /// Overall unstable fraction of the cases done.
     pub unstable_fraction: f64,
     /// Its 95 % confidence interval (Wilson score; meaningful for random layouts).
@@ -292,6 +296,7 @@ pub fn summarize(def: &StudyDef, list: &CaseList, records: &[Record]) -> Summary
         skipped: list.skipped.clone(),
         failed: records.iter().filter(|r| r.error.is_some()).count(),
         unstable_cases: n_unstable,
+        neutral_cases: records.iter().filter(|r| !r.neutral.is_empty()).count(),
         unstable_fraction: if records.is_empty() {
             0.0
         } else {

@@ -28,7 +28,7 @@ fn solve() -> SolveSpec {
         modal: "arpack".into(),
         band_hz: [0.0, 5000.0],
         tol: 1e-10,
-        dvr_tol: 1e-6,
+        dvr_margin: 0.0,
         classes_hz: vec![2100.0, 3500.0],
         class_width: 0.2,
     }
@@ -361,6 +361,7 @@ fn records_round_trip_through_a_json_line() {
             backward_error: 1e-12,
             class_hz: Some(2100.0),
         }],
+        neutral: vec![[900.0, -1e-9]],
         modes: vec![[900.0, -1e-9], [2101.5, 0.0123]],
         max_backward_error: 1e-12,
         error: None,
@@ -403,6 +404,7 @@ fn summaries_count_classes_per_group() {
             modes: Vec::new(),
             max_backward_error: 0.0,
             error: None,
+            neutral: Vec::new(),
         })
         .collect();
     let s = summarize(&d, &list, &records);

@@ -4,6 +4,7 @@
 
 use super::{Branch, Checkpoint, SweepPoint};
 use crate::outdir::{self, RunError};
+use squeal_core::operator::Stability;
 use std::io::Write;
 use std::path::Path;
 
@@ -79,7 +80,10 @@ pub fn max_error_bound(points: &[SweepPoint]) -> f64 {
 }
 
 /// Writes `sweep.csv`: one row per mode and point, the swept value in column `column`,
-/// the branch the mode belongs to, and whether its DvR exceeds `tol`.
+/// the branch the mode belongs to, whether it is unstable (`unstable` 0/1), its class
+/// (`stability`: unstable, neutral or stable) and the bound of its real part it was
+/// decided by (`re_bound`, 1/s; empty when its sign alone decided), with the physical
+/// DvR margin `tol` ([`squeal_core::operator::classify`]).
 pub fn write_csv(
     path: &Path,
     column: &str,
@@ -93,7 +97,7 @@ pub fn write_csv(
     };
     let mut f = std::io::BufWriter::new(std::fs::File::create(path).map_err(failed)?);
     let mut text = format!(
-        "{column},branch,mode,freq_hz,re,dvr,unstable,backward_error,cond,error_bound,active_pairs,basis_size\n"
+        "{column},branch,mode,freq_hz,re,dvr,unstable,backward_error,cond,error_bound,active_pairs,basis_size,stability,re_bound\n"
     );
     // an estimate that was not computed is an empty field
     let num = |x: f64| {
@@ -105,12 +109,13 @@ pub fn write_csv(
     };
     for (p, pt) in points.iter().enumerate() {
         for (m, md) in pt.modes.iter().enumerate() {
+            let verdict = md.verdict(tol);
             let b = branches
                 .iter()
                 .find(|b| b.modes[p] == Some(m))
                 .map_or(usize::MAX, |b| b.id);
             text += &format!(
-                "{},{},{},{:.6},{:.6e},{:.6e},{},{:.3e},{},{},{},{}\n",
+                "{},{},{},{:.6},{:.6e},{:.6e},{},{:.3e},{},{},{},{},{},{}\n",
                 pt.value,
                 b,
                 m,
@@ -118,12 +123,14 @@ pub fn write_csv(
                 // `+ 0.0` writes an undamped mode's -0 as 0
                 md.re + 0.0,
                 md.dvr + 0.0,
-                u8::from(md.dvr > tol),
+                u8::from(verdict.class == Stability::Unstable),
                 md.backward_error,
                 num(md.cond),
                 num(md.error_bound),
                 pt.active_pairs,
-                pt.basis_size
+                pt.basis_size,
+                verdict.class,
+                num(verdict.re_bound)
             );
         }
     }

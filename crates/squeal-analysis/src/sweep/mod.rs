@@ -21,7 +21,8 @@
 //! doublet stays on its two branches as long as the pair keeps its subspace.
 //!
 //! **Couplings.** A coupling is a maximal run of consecutive sweep points where a branch is
-//! unstable (`DvR > dvr_tol`); it reports the frequency at the largest DvR, the interval of
+//! unstable (its real part above its forward error bound, and its DvR above the optional
+//! physical margin: [`squeal_core::operator::classify`]); it reports the frequency at the largest DvR, the interval of
 //! the swept value (first and last unstable value), the largest DvR and the partner
 //! branch: the branch with the nearest frequency and the most negative DvR over the same
 //! interval (the mode it merged with, whose DvR mirrors it).
@@ -38,6 +39,7 @@ pub fn active_hash(active: &[bool]) -> u64 {
     h ^ (active.len() as u64)
 }
 use squeal_core::c64;
+use squeal_core::operator::{classify, Stability, Verdict};
 
 pub mod files;
 
@@ -69,6 +71,35 @@ pub struct SweepMode {
     /// Coefficients on the reference modes of tracking (the free-interface modes of a
     /// scene): (re, im) pairs.
     pub signature: Vec<[f64; 2]>,
+}
+
+impl SweepMode {
+    /// The eigenvalue `Re + i 2 pi f` (1/s).
+    pub fn lambda(&self) -> c64 {
+        c64::new(self.re, 2.0 * std::f64::consts::PI * self.freq_hz)
+    }
+
+    /// The stability class and the bound of the real part it was decided by
+    /// ([`squeal_core::operator::classify`]).
+    pub fn verdict(&self, dvr_margin: f64) -> Verdict {
+        classify(self.lambda(), self.backward_error, self.cond, dvr_margin)
+    }
+
+    /// The stability class ([`SweepMode::verdict`]).
+    pub fn stability(&self, dvr_margin: f64) -> Stability {
+        self.verdict(dvr_margin).class
+    }
+}
+
+impl SweepPoint {
+    /// How many of the point's modes fall in each class, `[unstable, neutral, stable]`.
+    pub fn class_counts(&self, dvr_margin: f64) -> [usize; 3] {
+        let mut counts = [0; 3];
+        for m in &self.modes {
+            counts[m.stability(dvr_margin).index()] += 1;
+        }
+        counts
+    }
 }
 
 /// Equal numbers, or both NaN (a quantity not computed on either side).
@@ -245,20 +276,24 @@ pub fn track(points: &[SweepPoint], opts: &TrackOptions) -> Vec<Branch> {
     branches
 }
 
-/// Detects couplings: runs of consecutive points where a branch has `DvR > dvr_tol`.
-pub fn couplings(points: &[SweepPoint], branches: &[Branch], dvr_tol: f64) -> Vec<Coupling> {
+/// Detects couplings: runs of consecutive points where a branch is unstable
+/// ([`SweepMode::stability`] with the physical margin `dvr_margin`).
+pub fn couplings(points: &[SweepPoint], branches: &[Branch], dvr_margin: f64) -> Vec<Coupling> {
     let mut out = Vec::new();
     let dvr = |b: &Branch, p: usize| b.modes[p].map(|m| points[p].modes[m].dvr);
+    let unstable = |b: &Branch, p: usize| {
+        b.modes[p].is_some_and(|m| points[p].modes[m].stability(dvr_margin) == Stability::Unstable)
+    };
     let freq = |b: &Branch, p: usize| b.modes[p].map(|m| points[p].modes[m].freq_hz);
     for b in branches {
         let mut p = 0;
         while p < points.len() {
-            if !dvr(b, p).is_some_and(|d| d > dvr_tol) {
+            if !unstable(b, p) {
                 p += 1;
                 continue;
             }
             let start = p;
-            while p < points.len() && dvr(b, p).is_some_and(|d| d > dvr_tol) {
+            while p < points.len() && unstable(b, p) {
                 p += 1;
             }
             let end = p - 1;

@@ -326,7 +326,10 @@ pub fn dense_symmetric_pencil(
     let n = k.nrows();
     let llt = m.llt(faer::Side::Lower).map_err(|e| Error::Factorization {
         what: "M (dense)".into(),
-        reason: format!("{e:?}: the mass matrix must be positive definite"),
+        reason: format!(
+            "{}: the mass matrix must be positive definite",
+            crate::linalg::explain::llt(&e, n)
+        ),
     })?;
     let l = llt.L().to_owned();
     // A = L^-1 K L^-T

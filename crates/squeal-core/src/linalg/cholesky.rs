@@ -36,7 +36,7 @@ impl SparseLlt {
             symmetric_ordering(ordering.as_ref()),
             CholeskySymbolicParams::default(),
         )
-        .map_err(|e| LltFailure::Symbolic(format!("{e:?}")))?;
+        .map_err(|e| LltFailure::Symbolic(super::explain::generic(&e)))?;
         let mut values = Vec::new();
         values.try_reserve_exact(symbolic.len_val()).map_err(|_| {
             LltFailure::Symbolic(format!(
@@ -62,7 +62,7 @@ impl SparseLlt {
                 MemStack::new(&mut mem),
                 Default::default(),
             )
-            .map_err(|e| LltFailure::Numeric(format!("{e:?}")))?;
+            .map_err(|e| LltFailure::Numeric(super::explain::llt(&e, a.nrows())))?;
         Ok(Self { symbolic, values })
     }
 
@@ -106,7 +106,10 @@ impl Cholesky {
             reason: match f {
                 LltFailure::Symbolic(e) => e,
                 LltFailure::Numeric(e) => {
-                    format!("{e} (not positive definite: are the rigid-body motions restrained?)")
+                    format!(
+                        "{e}: are the rigid-body motions restrained, and is the matrix \
+                         symmetric positive definite?"
+                    )
                 }
             },
         })?;

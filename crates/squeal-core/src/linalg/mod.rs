@@ -1,12 +1,16 @@
 //! Shared sparse linear algebra: combinations, products (real and complex), norms and the
-//! sparse Cholesky factorization every symmetric solve uses ([`Cholesky`]).
+//! sparse Cholesky factorization every symmetric solve uses ([`Cholesky`]), and the
+//! inertia of a symmetric matrix ([`inertia`]).
 
 mod cholesky;
 mod complex;
+pub(crate) mod explain;
+mod inertia;
 
 pub use cholesky::Cholesky;
 pub(crate) use cholesky::{LltFailure, SparseLlt};
 pub use complex::spmv_complex;
+pub use inertia::{inertia, Inertia, ZERO_PIVOT_REL};
 
 /// A solver of `A X = B` in place for a block of right-hand sides: a sparse factorization
 /// ([`Cholesky`]), or a solve assembled from others (the tied solves of

@@ -110,7 +110,7 @@ impl SymmetricPencil {
         )
         .map_err(|e| Error::Factorization {
             what: format!("K_c - s M_c (symbolic, n = {n})"),
-            reason: format!("{e:?}"),
+            reason: crate::linalg::explain::generic(&e),
         })?;
         Ok(Self {
             pattern,

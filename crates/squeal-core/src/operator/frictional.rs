@@ -3,6 +3,7 @@
 use crate::linalg::add_scaled;
 use crate::operator::Qep;
 use crate::{Error, Result, SparseMat};
+use std::sync::{Arc, OnceLock};
 
 /// The constrained frictional operator of one contact set: the mu-independent parts
 /// `X_c = T^T X T` and the friction parts `F_X`, kept apart so that
@@ -31,6 +32,73 @@ pub struct FrictionalOperator {
     /// responses `K_c^-1 U`). `None` when unknown (an operator read from files);
     /// [`crate::reduction::friction_load_directions`] then recovers their span from `F_K`.
     pub friction_loads: Option<SparseMat>,
+    /// The symmetric positive definite pair real modes and static responses are drawn
+    /// from ([`RealModePair`], [`crate::reduction::real_mode_pair`]).
+    pub modal: RealModePair,
+}
+
+/// Where the bases and the tracking of an operator take their real modes from: a
+/// symmetric positive definite pair `(K_s, M_s)`.
+///
+/// An operator squeal assembles from a scene has symmetric `K_c`, `M_c`, positive
+/// definite once the contact set's ties restrain the rigid-body motions ([`Own`]). An
+/// operator read from files may have circulatory, gyroscopic-stiffness or negative
+/// geometric terms in `K_c`, whose symmetric part is then indefinite: its pair is built on
+/// first use ([`Lazy`]) from the pair its directory names (`[modal]` of an
+/// `operator.toml`) or from the symmetric parts of `K_c` and `M_c`, shifted positive
+/// definite by a value found from their inertia ([`crate::reduction::real_mode_pair`]).
+///
+/// [`Own`]: RealModePair::Own
+/// [`Lazy`]: RealModePair::Lazy
+#[derive(Debug, Clone, Default)]
+pub enum RealModePair {
+    /// `(K_c, M_c)` themselves, symmetric positive definite.
+    #[default]
+    Own,
+    /// Built on first use and shared by the operator's clones.
+    Lazy(Arc<LazyPair>),
+}
+
+impl RealModePair {
+    /// A pair built on first use from `k` and `m` (`None`: the operator's own `K_c`,
+    /// `M_c`), described by `source` in notes and outputs.
+    pub fn lazy(k: Option<SparseMat>, m: Option<SparseMat>, source: impl Into<String>) -> Self {
+        RealModePair::Lazy(Arc::new(LazyPair {
+            k,
+            m,
+            source: source.into(),
+            built: OnceLock::new(),
+        }))
+    }
+}
+
+/// The inputs of a pair built on first use ([`RealModePair::Lazy`]) and, once built, the
+/// pair (or why it could not be built).
+#[derive(Debug)]
+pub struct LazyPair {
+    /// The stiffness it starts from (`None`: `K_c`), N/m; its symmetric part is taken.
+    pub k: Option<SparseMat>,
+    /// The mass it starts from (`None`: `M_c`), kg; its symmetric part is taken.
+    pub m: Option<SparseMat>,
+    /// What `k` and `m` are (e.g. "`[modal]` of brake/operator.toml: K = K1, M = M").
+    pub source: String,
+    /// The pair, built by [`crate::reduction::real_mode_pair`].
+    pub built: OnceLock<std::result::Result<Arc<ModalPair>, String>>,
+}
+
+/// A symmetric positive definite pair `(K_s, M_s)` ([`RealModePair`]).
+#[derive(Debug, Clone)]
+pub struct ModalPair {
+    /// `K_s` (N/m): the symmetric part of the pair's stiffness plus `shift M_s`, both
+    /// triangles stored, positive definite.
+    pub k: SparseMat,
+    /// `M_s` (kg): the symmetric part of the pair's mass, both triangles stored.
+    pub m: SparseMat,
+    /// The shift (rad/s)^2 that made `K_s` definite (0 when it was): the pair's real
+    /// modes are those of `(K_s, M_s)` with `omega^2 = omega_s^2 - shift`.
+    pub shift: f64,
+    /// Where it comes from and how it was made definite, for notes and outputs.
+    pub source: String,
 }
 
 impl FrictionalOperator {
@@ -42,6 +110,14 @@ impl FrictionalOperator {
     /// Number of DOFs of the unconstrained model (`dim()` when there is no map).
     pub fn full_dim(&self) -> usize {
         self.t.as_ref().map_or(self.dim(), |t| t.len())
+    }
+
+    /// Whether the operator has friction parts (a nonzero `F_M`, `F_C` or `F_K`): without
+    /// them mu changes nothing.
+    pub fn has_friction(&self) -> bool {
+        self.fm.compute_nnz() > 0
+            || self.fk.compute_nnz() > 0
+            || self.fc.as_ref().is_some_and(|f| f.compute_nnz() > 0)
     }
 
     /// Checks what every operator of a structure satisfies, for operators read from

@@ -7,6 +7,9 @@ mod frictional;
 mod modes;
 mod qep;
 
-pub use frictional::FrictionalOperator;
-pub use modes::{ComplexModes, RealModes, SolveInfo, StopReason};
+pub use frictional::{FrictionalOperator, LazyPair, ModalPair, RealModePair};
+pub use modes::{
+    classify, needs_condition, ComplexModes, RealModes, SolveInfo, Stability, StopReason, Verdict,
+    BACKWARD_ERROR_FLOOR, MIN_COND, SQRT_RULE,
+};
 pub use qep::{check_qep, Qep};

@@ -43,11 +43,165 @@ impl ComplexModes {
     pub fn is_empty(&self) -> bool {
         self.lambda.is_empty()
     }
-    /// Whether mode `i` is unstable: its divergence rate `DvR = Re / Im` exceeds
-    /// `dvr_tol` (the one threshold of every command, `--dvr-tol`).
-    pub fn is_unstable(&self, i: usize, dvr_tol: f64) -> bool {
-        self.dvr[i] > dvr_tol
+    /// The stability class of mode `i` ([`classify`]): decided by its real part against
+    /// its forward error bound, and beyond the optional physical margin `dvr_margin` on
+    /// the divergence rate (0: none).
+    pub fn stability(&self, i: usize, dvr_margin: f64) -> Stability {
+        self.verdict(i, dvr_margin).class
     }
+
+    /// The class of mode `i` with the bound it was decided by ([`classify`]).
+    pub fn verdict(&self, i: usize, dvr_margin: f64) -> Verdict {
+        classify(
+            self.lambda[i],
+            self.backward_error[i],
+            self.cond[i],
+            dvr_margin,
+        )
+    }
+
+    /// Whether mode `i` is unstable ([`stability`](Self::stability)).
+    pub fn is_unstable(&self, i: usize, dvr_margin: f64) -> bool {
+        self.stability(i, dvr_margin) == Stability::Unstable
+    }
+
+    /// How many modes fall in each class, `[unstable, neutral, stable]`.
+    pub fn class_counts(&self, dvr_margin: f64) -> [usize; 3] {
+        let mut counts = [0; 3];
+        for i in 0..self.len() {
+            counts[self.stability(i, dvr_margin).index()] += 1;
+        }
+        counts
+    }
+}
+
+/// The rounding floor of a backward error: a residual `Q(lambda) u` evaluated in double
+/// precision carries an error of a few tens of units of round-off of the terms it sums, so
+/// a computed backward error below this resolves nothing, and the bound of a mode uses at
+/// least this.
+pub const BACKWARD_ERROR_FLOOR: f64 = 64.0 * f64::EPSILON;
+
+/// The smallest condition number an eigenvalue can have in the norms of
+/// [`ComplexModes::cond`] (`|y^H Q'(lambda) x| <= ||y|| ||x|| (2 |lambda| ||M|| + ||C||)`,
+/// so `cond >= 1/2`): a real part below `MIN_COND` times the backward error is within the
+/// bound whatever the condition.
+pub const MIN_COND: f64 = 0.5;
+
+/// A real part larger than this many times `sqrt(backward error) |lambda|` keeps its sign
+/// whatever the condition: even at a coalescence, where the first-order bound fails, an
+/// eigenvalue moves by about the square root of the perturbation.
+pub const SQRT_RULE: f64 = 10.0;
+
+/// The stability class of a mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Stability {
+    /// `Re(lambda)` above its forward error bound (and the divergence rate above the
+    /// physical margin, when one is asked): certainly growing.
+    Unstable,
+    /// `Re(lambda)` within its bound (or a positive divergence rate within the margin):
+    /// the solve cannot tell the sign, e.g. the round-off real parts of an undamped
+    /// operator's uncoupled modes, or a mode at a coalescence.
+    Neutral,
+    /// `Re(lambda)` below minus its bound: certainly decaying.
+    Stable,
+}
+
+impl Stability {
+    /// Every class, in the order of [`Stability::index`].
+    pub const ALL: [Stability; 3] = [Stability::Unstable, Stability::Neutral, Stability::Stable];
+
+    /// `"unstable"`, `"neutral"` or `"stable"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stability::Unstable => "unstable",
+            Stability::Neutral => "neutral",
+            Stability::Stable => "stable",
+        }
+    }
+
+    /// Position in [`Stability::ALL`] (0 unstable, 1 neutral, 2 stable).
+    pub fn index(self) -> usize {
+        match self {
+            Stability::Unstable => 0,
+            Stability::Neutral => 1,
+            Stability::Stable => 2,
+        }
+    }
+}
+
+impl std::fmt::Display for Stability {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A mode's class and the bound of its real part it was decided by.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Verdict {
+    /// The class.
+    pub class: Stability,
+    /// Forward error bound of `Re(lambda)` (1/s): `cond x max(backward error,
+    /// BACKWARD_ERROR_FLOOR) x |lambda|`; NaN when the class did not need it (no `cond`
+    /// and a real part far beyond any bound, see [`classify`]).
+    pub re_bound: f64,
+}
+
+/// Whether the class of an eigenvalue with this backward error depends on its condition
+/// number: a real part between the smallest bound any condition gives
+/// (`MIN_COND x eta x |lambda|`) and the square-root rule (`SQRT_RULE x sqrt(eta) x
+/// |lambda|`), `eta` the backward error floored at [`BACKWARD_ERROR_FLOOR`]. Full-order
+/// solves compute `cond` for these modes only (see
+/// [`Condition::Auto`](crate::qep::Condition)).
+pub fn needs_condition(lambda: crate::c64, backward_error: f64) -> bool {
+    let e = floored(backward_error);
+    let (re, a) = (lambda.re.abs(), lambda.norm());
+    re > MIN_COND * e * a && re < SQRT_RULE * e.sqrt() * a
+}
+
+fn floored(backward_error: f64) -> f64 {
+    if backward_error.is_nan() {
+        f64::INFINITY
+    } else {
+        backward_error.max(BACKWARD_ERROR_FLOOR)
+    }
+}
+
+/// The stability class of an eigenvalue `lambda` (1/s) with its backward error and
+/// condition number on the full operator.
+///
+/// The forward error bound of the real part is `b = cond x eta x |lambda|` (`eta` the
+/// backward error, at least [`BACKWARD_ERROR_FLOOR`]): the mode is **unstable** when
+/// `Re(lambda) > b` and its divergence rate `Re / Im` exceeds `dvr_margin` (a physical
+/// margin; 0 for none), **stable** when `Re(lambda) < -b`, **neutral** otherwise. An
+/// infinite `cond` (a defective eigenvalue, where the first-order bound fails) takes the
+/// square-root rule `b = sqrt(eta) |lambda|`. Without `cond` (NaN): a real part within
+/// `MIN_COND x eta x |lambda|` is neutral (no condition number is smaller), one beyond
+/// `SQRT_RULE x sqrt(eta) x |lambda|` is decided by its sign (bound NaN), and one in
+/// between ([`needs_condition`]) is neutral within that conservative bound.
+pub fn classify(lambda: crate::c64, backward_error: f64, cond: f64, dvr_margin: f64) -> Verdict {
+    let e = floored(backward_error);
+    let (re, a) = (lambda.re, lambda.norm());
+    let re_bound = if cond.is_finite() {
+        cond * e * a
+    } else if cond.is_infinite() {
+        e.sqrt() * a
+    } else if re.abs() <= MIN_COND * e * a {
+        MIN_COND * e * a
+    } else if re.abs() >= SQRT_RULE * e.sqrt() * a {
+        f64::NAN
+    } else {
+        SQRT_RULE * e.sqrt() * a
+    };
+    let b = if re_bound.is_nan() { 0.0 } else { re_bound };
+    let dvr = re / lambda.im;
+    let class = if re > b && (dvr > dvr_margin || dvr.is_nan()) {
+        Stability::Unstable
+    } else if re < -b {
+        Stability::Stable
+    } else {
+        Stability::Neutral
+    };
+    Verdict { class, re_bound }
 }
 
 /// Real normal modes in a band, sorted by frequency.

@@ -49,12 +49,14 @@ use faer::{Mat, MatRef};
 /// mode on a shared symbolic analysis.
 pub const DENSE_LEFT_MAX_DIM: usize = 1000;
 
-/// Size up to which [`Condition::Auto`] computes left eigenvectors (so every reduced
-/// solve, and full-order solves of small models). Past it the sparse complex LU per mode
-/// costs several times the band solve itself (measured on the 1773-DOF coarse rig,
-/// 18 modes: 0.38 s without, 2.9 s with), and undamped operators past
+/// Size up to which [`Condition::Auto`] computes left eigenvectors for every mode (so
+/// every reduced solve, and full-order solves of small models). Past it the sparse complex
+/// LU per mode costs several times the band solve itself (measured on the 1773-DOF coarse
+/// rig, 18 modes: 0.38 s without, 2.9 s with), and undamped operators past
 /// [`LOW_RANK_AUTO_MIN_DIM`](super::LOW_RANK_AUTO_MIN_DIM) are solved without any LU at
-/// all: ask for [`Condition::Always`] there.
+/// all: there [`Condition::Auto`] computes them only for the modes whose stability class
+/// depends on them ([`needs_condition`](crate::operator::needs_condition)), and
+/// [`Condition::Always`] for every mode.
 pub const CONDITION_AUTO_MAX_DIM: usize = 1000;
 
 /// Eigenvalues closer than this (relative) are treated as one cluster when their left
@@ -64,7 +66,11 @@ pub const CLUSTER_REL: f64 = 1e-8;
 /// Whether a solve computes left eigenvectors (and so `cond` and `error_bound`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Condition {
-    /// When the problem size is at most [`CONDITION_AUTO_MAX_DIM`].
+    /// For every mode when the problem size is at most [`CONDITION_AUTO_MAX_DIM`]; above,
+    /// for the modes whose stability class depends on them
+    /// ([`needs_condition`](crate::operator::needs_condition): a real part between the
+    /// smallest bound any condition gives and the square-root rule), usually none or a
+    /// few.
     #[default]
     Auto,
     /// Always (one factorization per mode).
@@ -74,13 +80,19 @@ pub enum Condition {
 }
 
 impl Condition {
-    /// Whether a problem of size `n` gets left eigenvectors.
+    /// Whether a problem of size `n` gets left eigenvectors for every mode.
     pub fn applies(self, n: usize) -> bool {
         match self {
             Condition::Auto => n <= CONDITION_AUTO_MAX_DIM,
             Condition::Always => true,
             Condition::Never => false,
         }
+    }
+
+    /// Whether a problem of size `n` gets left eigenvectors for the modes whose class
+    /// depends on them, when not for every mode.
+    pub fn where_needed(self, n: usize) -> bool {
+        self == Condition::Auto && n > CONDITION_AUTO_MAX_DIM
     }
 }
 
@@ -92,6 +104,27 @@ pub(super) enum LeftSource<'a> {
     Given(MatRef<'a, c64>),
     /// Inverse iteration on this assembled problem.
     InverseIteration(&'a Qep),
+    /// Inverse iteration on this problem for the modes whose class depends on their
+    /// condition only ([`crate::operator::needs_condition`]); the problem is assembled
+    /// when one does.
+    WhereNeeded(NeededProblem<'a>),
+}
+
+/// The problem [`LeftSource::WhereNeeded`] solves with, assembled or not.
+pub(super) enum NeededProblem<'a> {
+    /// Assembled.
+    Qep(&'a Qep),
+    /// A frictional operator at `mu`, assembled only if a mode needs it.
+    Operator(&'a crate::operator::FrictionalOperator, f64),
+}
+
+impl NeededProblem<'_> {
+    pub(super) fn qep(&self) -> Result<std::borrow::Cow<'_, Qep>> {
+        Ok(match self {
+            NeededProblem::Qep(q) => std::borrow::Cow::Borrowed(*q),
+            NeededProblem::Operator(op, mu) => std::borrow::Cow::Owned(op.at(*mu)?),
+        })
+    }
 }
 
 /// `y = sum s_i A_i x` over `terms`.

@@ -3,12 +3,12 @@
 //! errors and, from left eigenvectors, condition numbers and error bounds
 //! ([`add_condition`]).
 
-use super::condition::{self, LeftSource};
+use super::condition::{self, LeftSource, NeededProblem};
 use super::residual::{check_pairs, QepTerms};
 use super::{left_eigenvectors, Condition};
 use crate::eigen::EigenParams;
 use crate::linalg::norm2_c;
-use crate::operator::{ComplexModes, FrictionalOperator, Qep, SolveInfo};
+use crate::operator::{needs_condition, ComplexModes, FrictionalOperator, Qep, SolveInfo};
 use crate::{c64, Error, Result};
 use faer::Mat;
 use std::time::Instant;
@@ -80,6 +80,8 @@ pub fn finish_modes_with(
 ) -> Result<ComplexModes> {
     let left = if condition.applies(qep.dim()) {
         LeftSource::InverseIteration(qep)
+    } else if condition.where_needed(qep.dim()) {
+        LeftSource::WhereNeeded(NeededProblem::Qep(qep))
     } else {
         LeftSource::None
     };
@@ -87,8 +89,10 @@ pub fn finish_modes_with(
 }
 
 /// [`finish_modes`] on `op.at(mu)`, without assembling it: the backward errors are
-/// computed on the parts `X_c - mu F_X` (the same numbers to round-off). No left
-/// eigenvectors (`cond` and `error_bound` are NaN); reduced solves use
+/// computed on the parts `X_c - mu F_X` (the same numbers to round-off). Left
+/// eigenvectors only for the modes whose stability class depends on their condition
+/// ([`needs_condition`]; `op.at(mu)` is then assembled for their inverse iteration),
+/// `cond` and `error_bound` NaN for the others; reduced solves use
 /// [`finish_operator_modes_with_left`].
 pub fn finish_operator_modes(
     op: &FrictionalOperator,
@@ -105,7 +109,7 @@ pub fn finish_operator_modes(
         &QepTerms::of_operator(op, mu),
         lambda,
         vectors,
-        LeftSource::None,
+        LeftSource::WhereNeeded(NeededProblem::Operator(op, mu)),
         params,
         info,
     )
@@ -251,8 +255,13 @@ fn finish_terms(
         freq.push(f);
         dvr.push(l.re / l.im);
     }
+    let mut where_needed = None;
     let left = match left {
         LeftSource::None => None,
+        LeftSource::WhereNeeded(problem) => {
+            where_needed = Some(problem);
+            None
+        }
         LeftSource::Given(y) => Some(Mat::from_fn(n, keep.len(), |r, c| y[(r, keep[c].1)])),
         LeftSource::InverseIteration(q) => {
             let t = Instant::now();
@@ -283,10 +292,45 @@ fn finish_terms(
         left.as_ref().map(|y| y.as_ref()),
         true,
     );
-    let (cond, error_bound) = match &left {
+    let (mut cond, mut error_bound) = match &left {
         Some(_) => condition::condition_from_products(&norms, &lam, &products, &be),
         None => (vec![f64::NAN; lam.len()], vec![f64::NAN; lam.len()]),
     };
+    if let Some(problem) = where_needed {
+        let need: Vec<usize> = (0..lam.len())
+            .filter(|&j| needs_condition(lam[j], be[j]))
+            .collect();
+        if !need.is_empty() {
+            let t = Instant::now();
+            let q = problem.qep()?;
+            let lam_n: Vec<c64> = need.iter().map(|&j| lam[j]).collect();
+            let be_n: Vec<f64> = need.iter().map(|&j| be[j]).collect();
+            let x = Mat::from_fn(n, need.len(), |r, c| out[(r, need[c])]);
+            let (y, how) = left_eigenvectors(&q, &lam_n, x.as_ref())?;
+            let (c, b) = condition::condition_numbers(
+                &QepTerms::of_qep(&q),
+                &norms,
+                &lam_n,
+                x.as_ref(),
+                y.as_ref(),
+                &be_n,
+            );
+            for (k, &j) in need.iter().enumerate() {
+                cond[j] = c[k];
+                error_bound[j] = b[k];
+            }
+            info.factorizations += how.factorizations;
+            info.notes.push(format!(
+                "cond, error_bound for the {} of {} modes whose stability class depends on \
+                 them (real part between the smallest bound and the square-root rule): {} \
+                 factorizations of Q(lambda), {:.3} s",
+                need.len(),
+                lam.len(),
+                how.factorizations,
+                t.elapsed().as_secs_f64()
+            ));
+        }
+    }
     Ok(ComplexModes {
         lambda: lam,
         vectors: out,

@@ -1,7 +1,7 @@
 //! The vectors bases start from: the coupled mu = 0 real modes ([`coupled_real_modes`])
 //! and the friction load directions ([`friction_load_directions`]).
 
-use super::{from_free_dofs, sparse_times, to_free_dofs, StaticSolver};
+use super::{from_free_dofs, real_mode_pair, sparse_times, to_free_dofs, StaticSolver};
 use crate::contact::BasisRequest;
 use crate::eigen::{EigenParams, SymmetricProblem};
 use crate::linalg::hcat;
@@ -10,12 +10,14 @@ use crate::{Error, Result};
 use faer::Mat;
 
 /// The coupled mu = 0 real modes of `(K_c, M_c)` from 0 to `cutoff_hz`, by
-/// `request.modal` (tolerances from `request.params`).
+/// `request.modal` (tolerances from `request.params`): of the operator's real-mode pair
+/// ([`real_mode_pair`]; `(K_c, M_c)` itself for a scene's operator), its shift undone
+/// in the eigenvalues.
 pub fn coupled_real_modes(request: &BasisRequest<'_>, cutoff_hz: f64) -> Result<RealModes> {
     real_modes(request, cutoff_hz, None)
 }
 
-/// [`coupled_real_modes`] on the factorization of a [`StaticSolver`] (`K_c + shift M_c`,
+/// [`coupled_real_modes`] on the factorization of a [`StaticSolver`] (`K_s + shift M_s`,
 /// the shift-invert operator's `sigma = -shift`): a basis that needs both the real modes
 /// and static responses factorizes once. A modal solver that does not work by
 /// shift-invert ignores the factor. In a sweep the iteration starts from the previous
@@ -48,11 +50,16 @@ fn real_modes(
         ..request.params.clone()
     };
     let op = request.op;
-    let problem = SymmetricProblem {
-        k: op.kc.as_ref(),
-        m: op.mc.as_ref(),
+    let pair = real_mode_pair(op)?;
+    let params = EigenParams {
+        fmax_hz: pair.shifted_cutoff_hz(cutoff_hz),
+        ..params
     };
-    match statics {
+    let problem = SymmetricProblem {
+        k: pair.k,
+        m: pair.m,
+    };
+    let modes = match statics {
         Some(s) => {
             let si = s.shift_invert(problem.m)?;
             let start = request
@@ -67,7 +74,8 @@ fn real_modes(
             )
         }
         None => request.modal.solve_symmetric(&problem, &params),
-    }
+    }?;
+    Ok(pair.unshift(modes))
 }
 
 /// How a basis's real modes were found, for its note: the columns the shift-invert

@@ -5,7 +5,7 @@
 //! images of the columns kept before.
 
 use super::orthonormal::m_orthonormal_extend_in_place;
-use super::project::{dense_to_sparse, project_loads, project_part};
+use super::project::{dense_to_sparse, is_symmetric, project_loads, project_part};
 use super::statics::{energy_norms, StaticSolver};
 use super::{expand, sparse_times, tmul};
 use crate::linalg::{spmv_complex, symmetric_times};
@@ -21,6 +21,8 @@ pub struct GrowingBasis<'a> {
     mv: Mat<f64>,
     kv: Mat<f64>,
     cv: Option<Mat<f64>>,
+    /// Whether `M_c` and `K_c` are exactly symmetric (their images by the gather product).
+    symmetric: [bool; 2],
 }
 
 /// Room for `more` columns after the ones of `a`, the column capacity grown in powers of
@@ -47,10 +49,18 @@ impl<'a> GrowingBasis<'a> {
                 got: v.nrows(),
             });
         }
-        let mv = symmetric_times(op.mc.as_ref(), v.as_ref());
-        let kv = symmetric_times(op.kc.as_ref(), v.as_ref());
+        let symmetric = [is_symmetric(op.mc.as_ref()), is_symmetric(op.kc.as_ref())];
+        let mv = times(op.mc.as_ref(), v.as_ref(), symmetric[0]);
+        let kv = times(op.kc.as_ref(), v.as_ref(), symmetric[1]);
         let cv = op.cc.as_ref().map(|c| sparse_times(c.as_ref(), v.as_ref()));
-        Ok(Self { op, v, mv, kv, cv })
+        Ok(Self {
+            op,
+            v,
+            mv,
+            kv,
+            cv,
+            symmetric,
+        })
     }
 
     /// Number of columns.
@@ -86,14 +96,14 @@ impl<'a> GrowingBasis<'a> {
         if w.ncols() > 0 {
             // the images of the new columns by exact sparse products (the orthonormalization
             // carried `M w` through its projections, with their roundoff)
-            let mw = symmetric_times(mc, w);
+            let mw = times(mc, w, self.symmetric[0]);
             self.mv
                 .as_mut()
                 .subcols_mut(before, w.ncols())
                 .copy_from(&mw);
             append(
                 &mut self.kv,
-                symmetric_times(self.op.kc.as_ref(), w).as_ref(),
+                times(self.op.kc.as_ref(), w, self.symmetric[1]).as_ref(),
             );
             if let (Some(cv), Some(c)) = (&mut self.cv, &self.op.cc) {
                 append(cv, sparse_times(c.as_ref(), w).as_ref());
@@ -123,6 +133,7 @@ impl<'a> GrowingBasis<'a> {
             fk: project_part(self.op.fk.as_ref(), v)?,
             t: None,
             friction_loads: project_loads(self.op, v)?,
+            modal: Default::default(),
         })
     }
 
@@ -139,6 +150,7 @@ impl<'a> GrowingBasis<'a> {
     ) -> (Vec<f64>, Mat<c64>) {
         let n = self.v.nrows();
         let k = lambda.len();
+        let own = ks.is_own();
         let u = expand(self.v.as_ref(), q);
         let mu_ = expand(self.mv.as_ref(), q);
         let ku = expand(self.kv.as_ref(), q);
@@ -165,13 +177,28 @@ impl<'a> GrowingBasis<'a> {
                 let v = k_ + l * (c_ + l * m_);
                 rr[(r, 2 * j)] = v.re;
                 rr[(r, 2 * j + 1)] = v.im;
-                let s = ku[(r, j)] + ks.shift * mu_[(r, j)];
-                ksu[(r, 2 * j)] = s.re;
-                ksu[(r, 2 * j + 1)] = s.im;
+                if own {
+                    let s = ku[(r, j)] + ks.shift * mu_[(r, j)];
+                    ksu[(r, 2 * j)] = s.re;
+                    ksu[(r, 2 * j + 1)] = s.im;
+                }
                 ur[(r, 2 * j)] = uj[r].re;
                 ur[(r, 2 * j + 1)] = uj[r].im;
             }
         }
+        if !own {
+            // a real-mode pair that is not the operator's own stiffness: K_s u directly
+            ksu = symmetric_times(ks.matrix(), ur.as_ref());
+        }
         energy_norms(ks, rr, ur.as_ref(), ksu.as_ref())
+    }
+}
+
+/// `X V`, by the gather product when `X` is symmetric.
+fn times(x: crate::SparseRef<'_>, v: MatRef<'_, f64>, symmetric: bool) -> Mat<f64> {
+    if symmetric {
+        symmetric_times(x, v)
+    } else {
+        sparse_times(x, v)
     }
 }

@@ -51,6 +51,7 @@ use faer::{Accum, Mat, MatRef, Par};
 mod candidates;
 mod growing;
 mod mac;
+mod modal;
 mod orthonormal;
 mod project;
 mod seed;
@@ -68,6 +69,7 @@ pub use candidates::{
 };
 pub use growing::GrowingBasis;
 pub use mac::mac_real_complex;
+pub use modal::{real_mode_pair, symmetric_part, PairRef};
 pub use orthonormal::{
     m_orthonormal_extend, m_orthonormal_extend_imaged, m_orthonormality_error, m_orthonormalize,
     m_svd_compress, DEFAULT_RANK_TOL,

@@ -164,6 +164,7 @@ pub fn project(op: &FrictionalOperator, v: MatRef<'_, f64>) -> Result<Frictional
         fk: project_part(op.fk.as_ref(), v)?,
         t: None,
         friction_loads,
+        modal: Default::default(),
     })
 }
 

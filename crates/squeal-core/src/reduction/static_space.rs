@@ -433,6 +433,7 @@ impl StaticSpace {
             fk: sparse(fk)?,
             t: None,
             friction_loads: Some(sparse(utb.transpose().to_owned())?),
+            modal: Default::default(),
         };
         Ok(StaticBasis {
             columns: StaticColumns {

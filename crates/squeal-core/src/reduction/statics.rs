@@ -1,12 +1,14 @@
 //! Static responses with one reused factorization ([`StaticSolver`]) and the
 //! energy-norm residuals of reduced modes ([`energy_residuals`]).
 
-use super::{friction_load_directions, PairSolves, TiedSolve};
+use super::{friction_load_directions, real_mode_pair, PairSolves, TiedSolve};
 use crate::linalg::{add_scaled, BlockSolve, Cholesky};
 use crate::linalg::{spmv_complex, symmetric_times};
 use crate::operator::FrictionalOperator;
 use crate::spectral::ShiftInvert;
 use crate::{c64, Error, Result, SparseMat, SparseRef};
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::{Mat, MatRef};
 use std::borrow::Cow;
 use std::time::Instant;
@@ -32,9 +34,23 @@ impl BlockSolve for Backend<'_> {
 /// `>= 0`): factorized once (sparse Cholesky, [`StaticSolver::new`]), or, at shift 0,
 /// solved through the free model's factor and the pairs of the contact set
 /// ([`StaticSolver::tied`]).
+///
+/// `K_c`, `M_c` here are the operator's real-mode pair ([`real_mode_pair`]): the
+/// operator's own for a scene, else the pair its directory names or its symmetric
+/// parts shifted definite. The responses to the friction loads
+/// ([`friction_statics`](Self::friction_statics)) of an operator that is not its own pair
+/// are solved with the operator's own stiffness `K_c` (a sparse LU of the
+/// non-symmetric matrix, built on first use), since they are the static deformation of
+/// that stiffness; the real modes and [`solve_in_place`](Self::solve_in_place) (the
+/// residue method's energy-norm residuals) use the pair.
 pub struct StaticSolver<'a> {
     factor: Backend<'a>,
     ks: Cow<'a, SparseMat>,
+    /// Whether `K_s` is the operator's own stiffness (its friction statics solve with it).
+    own: bool,
+    /// The sparse LU of the operator's own `K_c`, for the friction statics of an operator
+    /// that is not its own pair (built on first use).
+    own_lu: std::sync::OnceLock<std::result::Result<Lu<usize, f64>, String>>,
     /// The shift (rad/s)^2.
     pub shift: f64,
     /// Set-up time (s): the factorization, or the Schur complement of the tied solve.
@@ -53,14 +69,31 @@ impl<'a> StaticSolver<'a> {
                 format!("static shift must be finite and >= 0 (rad/s)^2, got {shift}"),
             ));
         }
-        let ks = add_scaled(op.kc.as_ref(), 1.0, op.mc.as_ref(), shift)?;
-        let factor = Cholesky::new(ks.as_ref(), "K_c + shift M_c (static responses)")?;
+        let pair = real_mode_pair(op)?;
+        let ks = add_scaled(pair.k, 1.0, pair.m, shift)?;
+        let what = if pair.own {
+            "K_c + shift M_c (static responses)".to_string()
+        } else {
+            format!("K_s + shift M_s of the real-mode pair ({})", pair.source)
+        };
+        let factor = Cholesky::new(ks.as_ref(), &what)?;
+        let method = if pair.own {
+            "K_c factorization".to_string()
+        } else {
+            format!(
+                "real modes and static solves of the real-mode pair ({}; Cholesky \
+                 factorization)",
+                pair.source
+            )
+        };
         Ok(Self {
             factor: Backend::Factor(factor),
             ks: Cow::Owned(ks),
+            own: pair.own,
+            own_lu: std::sync::OnceLock::new(),
             shift,
             time_s: start.elapsed().as_secs_f64(),
-            method: "K_c factorization".into(),
+            method,
         })
     }
 
@@ -76,6 +109,8 @@ impl<'a> StaticSolver<'a> {
         Ok(Self {
             factor: Backend::Tied(solve),
             ks: Cow::Borrowed(&op.kc),
+            own: true,
+            own_lu: std::sync::OnceLock::new(),
             shift: 0.0,
             time_s: start.elapsed().as_secs_f64(),
             method,
@@ -120,7 +155,16 @@ impl<'a> StaticSolver<'a> {
             }
         }
         let mut u = friction_load_directions(op)?;
-        self.solve_in_place(u.as_mut());
+        if self.own {
+            self.solve_in_place(u.as_mut());
+        } else {
+            let lu = self
+                .own_lu
+                .get_or_init(|| own_lu(op).map_err(|e| e.to_string()))
+                .as_ref()
+                .map_err(|e| Error::Invalid(e.clone()))?;
+            lu.solve_in_place(u.as_mut());
+        }
         Ok((u, false))
     }
 
@@ -143,10 +187,41 @@ impl<'a> StaticSolver<'a> {
         ))
     }
 
+    /// Whether `K_s` is the operator's own `K_c` (plus `shift M_c`): a scene's operator,
+    /// not a real-mode pair of its own ([`real_mode_pair`]).
+    pub fn is_own(&self) -> bool {
+        self.own
+    }
+
     /// The matrix `K_s` this solver solves with.
     pub fn matrix(&self) -> SparseRef<'_> {
         self.ks.as_ref().as_ref()
     }
+}
+
+/// The sparse LU of the operator's own (non-symmetric) `K_c`, checked on a probe solve.
+fn own_lu(op: &FrictionalOperator) -> Result<Lu<usize, f64>> {
+    let n = op.dim();
+    let what = || format!("K_c of the operator (n = {n}, sparse LU for the friction statics)");
+    let sym = SymbolicLu::try_new(op.kc.symbolic()).map_err(|e| Error::Factorization {
+        what: what(),
+        reason: crate::linalg::explain::generic(&e),
+    })?;
+    let lu = Lu::try_new_with_symbolic(sym, op.kc.as_ref()).map_err(|e| Error::Factorization {
+        what: what(),
+        reason: crate::linalg::explain::lu(&e, n),
+    })?;
+    let mut y: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
+    lu.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut y, n, 1));
+    if y.iter().any(|v| !v.is_finite()) {
+        return Err(Error::Factorization {
+            what: what(),
+            reason: "numerically singular: the operator's stiffness has no static solution \
+                     (unrestrained rigid-body motions?)"
+                .into(),
+        });
+    }
+    Ok(lu)
 }
 
 /// Residual of the reduced modes `(lambda_j, u_j = V q_j)` on the full `qep`, in the

@@ -62,6 +62,7 @@ fn operator(n: usize, na: usize, with_loads: bool, seed: u64) -> FrictionalOpera
         fk: sparse(fk.as_ref()),
         t: None,
         friction_loads: with_loads.then(|| sparse(u.as_ref())),
+        modal: Default::default(),
     }
 }
 
@@ -573,6 +574,7 @@ fn tied_model(active: &[usize]) -> (SparseMat, Vec<PairDofs>, FrictionalOperator
         fk: sparse(Mat::<f64>::zeros(nc, nc).as_ref()),
         t: Some(t),
         friction_loads: None,
+        modal: Default::default(),
     };
     (sparse(k.as_ref()), pairs, op, kc)
 }

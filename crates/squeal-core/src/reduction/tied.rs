@@ -368,7 +368,10 @@ impl PairSolves {
         let saa = Mat::from_fn(na, na, |i, j| self.s[(active[i], active[j])]);
         let llt = saa.llt(Side::Lower).map_err(|e| Error::Factorization {
             what: format!("S_AA = C_A K^-1 C_A^T ({na} active pairs)"),
-            reason: format!("{e:?}: the pair flexibility must be positive definite"),
+            reason: format!(
+                "{}: the pair flexibility must be positive definite",
+                crate::linalg::explain::llt(&e, na)
+            ),
         })?;
         // runs of consecutive active pairs: `Z_A lambda` as a few products on column
         // ranges of `Z` instead of a copy of `Z_A`

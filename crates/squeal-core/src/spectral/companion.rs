@@ -70,7 +70,7 @@ impl QepSymbolic {
             .0;
         let lu = SymbolicLu::try_new(pattern.as_ref()).map_err(|e| Error::Factorization {
             what: format!("Q(sigma) = sigma^2 M + sigma C + K (symbolic, n = {n})"),
-            reason: format!("{e:?}"),
+            reason: crate::linalg::explain::generic(&e),
         })?;
         Ok(Self { pattern, lu })
     }
@@ -180,7 +180,7 @@ impl<'a> QepShiftInvert<'a> {
         let lu = Lu::try_new_with_symbolic(symbolic.lu.clone(), q).map_err(|e| {
             Error::Factorization {
                 what: what(),
-                reason: format!("{e:?}"),
+                reason: crate::linalg::explain::lu(&e, n),
             }
         })?;
         // A singular Q(sigma) (sigma on an eigenvalue) shows up as non-finite solves.

@@ -60,8 +60,9 @@ impl<'a> ShiftInvert<'a> {
         let llt = SparseLlt::new(shifted.as_ref()).map_err(|f| match f {
             LltFailure::Symbolic(e) => fail(e),
             LltFailure::Numeric(e) => fail(format!(
-                "{e} (not positive definite: is sigma below the lowest eigenvalue, \
-                 and are the rigid-body motions of K restrained or M positive?)"
+                "{e}: an eigenvalue of (K, M) lies below sigma (a negative one, if K is \
+                 indefinite), or K has unrestrained rigid-body motions, or M is not positive \
+                 definite"
             )),
         })?;
         Ok(Self {

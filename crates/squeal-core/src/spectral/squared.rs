@@ -56,11 +56,11 @@ impl<'a> SquaredShift<'a> {
         let what = || format!("K - s M (s = {sigma_s:.6e} (rad/s)^2, n = {n})");
         let sym = SymbolicLu::try_new(a.symbolic()).map_err(|e| Error::Factorization {
             what: what(),
-            reason: format!("{e:?}"),
+            reason: crate::linalg::explain::generic(&e),
         })?;
         let lu = Lu::try_new_with_symbolic(sym, a.as_ref()).map_err(|e| Error::Factorization {
             what: what(),
-            reason: format!("{e:?}"),
+            reason: crate::linalg::explain::lu(&e, n),
         })?;
         let mut y: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
         lu.solve_in_place(MatMut::from_column_major_slice_mut(&mut y, n, 1));

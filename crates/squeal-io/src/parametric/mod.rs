@@ -29,6 +29,7 @@ use crate::operator::{read_operator_dir, FILE_META};
 use crate::IoError;
 use faer::sparse::{SymbolicSparseColMat, Triplet};
 use squeal_core::linalg::{add_scaled, norm1, Cholesky};
+use squeal_core::operator::RealModePair;
 use squeal_core::{FrictionalOperator, SparseMat};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -40,7 +41,7 @@ pub const PARAMETRIC_FORMAT: &str = "squeal-parametric-operator";
 /// The parts an `operator.toml` may define, in [`FrictionalOperator`] order.
 pub const PARTS: [&str; 6] = ["M", "C", "K", "FM", "FC", "FK"];
 
-const TOP_KEYS: [&str; 7] = [
+const TOP_KEYS: [&str; 8] = [
     "format",
     "version",
     "parameter",
@@ -48,6 +49,7 @@ const TOP_KEYS: [&str; 7] = [
     "mat",
     "components",
     "U",
+    "modal",
 ];
 
 /// Relative size of the smallest eigenvalue of the symmetric part of `M` (against
@@ -85,6 +87,8 @@ pub struct ParametricOperator {
     parameter: Option<String>,
     range: Option<(f64, f64)>,
     parts: [Vec<Term>; 6],
+    /// The real-mode pair `[M, K]` of `[modal]`, when the description names one.
+    modal: Option<[Vec<Term>; 2]>,
     dim: usize,
     friction_loads: Option<SparseMat>,
     t: Option<Vec<usize>>,
@@ -147,37 +151,49 @@ impl ParametricOperator {
         let n = self.dim;
         let mut out: [Option<SparseMat>; 6] = Default::default();
         for (p, terms) in self.parts.iter().enumerate() {
-            if terms.is_empty() {
-                continue;
+            if !terms.is_empty() {
+                out[p] = Some(self.sum(terms, PARTS[p], value)?);
             }
-            let mut acc = zero(n);
-            for (i, term) in terms.iter().enumerate() {
-                let c = term.coeff(value);
-                if !c.is_finite() {
-                    return Err(perr(
-                        &self.file,
-                        format!("{}[{i}].coeff", PARTS[p]),
-                        format!(
-                            "`{}` of `{}` is {c} at {name} = {value}",
-                            term.coeff_text, term.matrix
-                        ),
-                        "a finite coefficient at this value",
-                    ));
-                }
-                acc = add_scaled(acc.as_ref(), 1.0, term.a.as_ref().as_ref(), c).map_err(|e| {
-                    perr(
-                        &self.file,
-                        PARTS[p],
-                        e.to_string(),
-                        "components of one size",
-                    )
-                })?;
-            }
-            out[p] = Some(acc);
         }
         let [m, c, k, fm, fc, fk] = out;
         let m = m.expect("M is required");
         self.check_mass(&m, value)?;
+        let at = match &self.parameter {
+            Some(name) => format!(" at {name} = {value}"),
+            None => String::new(),
+        };
+        let modal = match &self.modal {
+            Some([pm, pk]) => {
+                let names = |terms: &[Term]| {
+                    terms
+                        .iter()
+                        .map(|t| match t.coeff_text.as_str() {
+                            "1" => t.matrix.clone(),
+                            c => format!("({c}) {}", t.matrix),
+                        })
+                        .collect::<Vec<_>>()
+                        .join(" + ")
+                };
+                RealModePair::lazy(
+                    Some(self.sum(pk, "modal.K", value)?),
+                    Some(self.sum(pm, "modal.M", value)?),
+                    format!(
+                        "[modal] of {}: K = {}, M = {}{at}",
+                        self.file.display(),
+                        names(pk),
+                        names(pm)
+                    ),
+                )
+            }
+            None => RealModePair::lazy(
+                None,
+                None,
+                format!(
+                    "symmetric parts of K and M of {}{at} (no [modal] pair given)",
+                    self.file.display()
+                ),
+            ),
+        };
         Ok(FrictionalOperator {
             mc: m,
             cc: c,
@@ -187,7 +203,31 @@ impl ParametricOperator {
             fk: fk.unwrap_or_else(|| zero(n)),
             t: self.t.clone(),
             friction_loads: self.friction_loads.clone(),
+            modal,
         })
+    }
+
+    /// `sum coeff_i(value) A_i` of the terms of the part `field`.
+    fn sum(&self, terms: &[Term], field: &str, value: f64) -> Result<SparseMat, IoError> {
+        let name = self.parameter.as_deref().unwrap_or("parameter");
+        let mut acc = zero(self.dim);
+        for (i, term) in terms.iter().enumerate() {
+            let c = term.coeff(value);
+            if !c.is_finite() {
+                return Err(perr(
+                    &self.file,
+                    format!("{field}[{i}].coeff"),
+                    format!(
+                        "`{}` of `{}` is {c} at {name} = {value}",
+                        term.coeff_text, term.matrix
+                    ),
+                    "a finite coefficient at this value",
+                ));
+            }
+            acc = add_scaled(acc.as_ref(), 1.0, term.a.as_ref().as_ref(), c)
+                .map_err(|e| perr(&self.file, field, e.to_string(), "components of one size"))?;
+        }
+        Ok(acc)
     }
 
     /// The symmetric part of `M` must be positive definite: a sparse Cholesky (fails on

@@ -148,6 +148,7 @@ impl ParametricOperator {
             fk,
             t,
             friction_loads,
+            modal: _,
         } = op;
         let dim = mc.nrows();
         Ok(Self {
@@ -162,6 +163,7 @@ impl ParametricOperator {
                 fc.map(|c| vec![term("FC", c)]).unwrap_or_default(),
                 vec![term("FK", fk)],
             ],
+            modal: None,
             dim,
             friction_loads,
             t,
@@ -391,48 +393,53 @@ impl ParametricOperator {
                 }
                 continue;
             };
-            let list = v.as_array().ok_or_else(|| {
-                perr(
-                    file,
-                    *part,
-                    "not a list",
-                    "a list of terms [\"A\", { matrix = \"B\", coeff = \"W^2\" }]",
-                )
-            })?;
-            if list.is_empty() {
+            parts[p] =
+                Self::read_terms(file, part, v, parameter.as_deref(), &mut loader, &mut dim)?;
+        }
+        let modal = match t.get("modal") {
+            None => None,
+            Some(toml::Value::Table(tb)) => {
+                for k in tb.keys() {
+                    if k != "M" && k != "K" {
+                        return Err(perr(
+                            file,
+                            format!("modal.{k}"),
+                            "unknown key",
+                            "M and K (the real-mode pair)",
+                        ));
+                    }
+                }
+                let mut pair: [Vec<Term>; 2] = Default::default();
+                for (i, part) in ["M", "K"].iter().enumerate() {
+                    let field = format!("modal.{part}");
+                    let v = tb.get(*part).ok_or_else(|| {
+                        perr(
+                            file,
+                            &field,
+                            "missing",
+                            "both M and K of the real-mode pair (e.g. M = [\"M\"], K = [\"K1\"])",
+                        )
+                    })?;
+                    pair[i] = Self::read_terms(
+                        file,
+                        &field,
+                        v,
+                        parameter.as_deref(),
+                        &mut loader,
+                        &mut dim,
+                    )?;
+                }
+                Some(pair)
+            }
+            Some(v) => {
                 return Err(perr(
                     file,
-                    *part,
-                    "empty list",
-                    "at least one term (omit an absent part)",
-                ));
+                    "modal",
+                    format!("{v}"),
+                    "a table [modal] with M and K",
+                ))
             }
-            for (i, item) in list.iter().enumerate() {
-                let field = format!("{part}[{i}]");
-                let (name, coeff_text, coeff) =
-                    Self::term(file, &field, item, parameter.as_deref())?;
-                let (a, source) = loader.load(&name)?;
-                if dim.is_none() {
-                    dim = Some((a.nrows(), source.clone()));
-                }
-                let (n, first) = dim.clone().expect("set above");
-                if a.nrows() != n || a.ncols() != n {
-                    return Err(IoError::Shape {
-                        file: PathBuf::from(&source),
-                        nrows: a.nrows(),
-                        ncols: a.ncols(),
-                        expected: format!("{n} x {n} like {first} (component `{name}` of {part})"),
-                    });
-                }
-                parts[p].push(Term {
-                    matrix: name,
-                    source,
-                    coeff_text,
-                    coeff,
-                    a,
-                });
-            }
-        }
+        };
         let (dim, _) = dim.expect("M is required");
         let friction_loads = match t.get("U") {
             None => None,
@@ -455,9 +462,65 @@ impl ParametricOperator {
             parameter,
             range,
             parts,
+            modal,
             dim,
             friction_loads,
             t: None,
         })
+    }
+
+    /// The terms of the part `field` (a list of component names or `{ matrix, coeff }`
+    /// tables), each component loaded and checked square of the common size `dim`
+    /// (set by the first one).
+    fn read_terms(
+        file: &Path,
+        field: &str,
+        v: &toml::Value,
+        parameter: Option<&str>,
+        loader: &mut Loader<'_>,
+        dim: &mut Option<(usize, String)>,
+    ) -> Result<Vec<Term>, IoError> {
+        let list = v.as_array().ok_or_else(|| {
+            perr(
+                file,
+                field,
+                "not a list",
+                "a list of terms [\"A\", { matrix = \"B\", coeff = \"W^2\" }]",
+            )
+        })?;
+        if list.is_empty() {
+            return Err(perr(
+                file,
+                field,
+                "empty list",
+                "at least one term (omit an absent part)",
+            ));
+        }
+        let mut out = Vec::with_capacity(list.len());
+        for (i, item) in list.iter().enumerate() {
+            let item_field = format!("{field}[{i}]");
+            let (name, coeff_text, coeff) = Self::term(file, &item_field, item, parameter)?;
+            let (a, source) = loader.load(&name)?;
+            if dim.is_none() {
+                *dim = Some((a.nrows(), source.clone()));
+            }
+            let (n, first) = dim.clone().expect("set above");
+            if a.nrows() != n || a.ncols() != n {
+                return Err(IoError::Shape {
+                    file: PathBuf::from(&source),
+                    nrows: a.nrows(),
+                    ncols: a.ncols(),
+                    expected: format!("{n} x {n} like {first} (component `{name}` of {field})"),
+                });
+            }
+            out.push(Term {
+                matrix: name,
+                source,
+                coeff_text,
+                coeff,
+                a,
+            });
+        }
+        Ok(out)
     }
 }

@@ -605,6 +605,7 @@ impl FreeInterface {
             fk: sparse(tmul(ptc.as_ref(), eskc.as_ref()))?,
             t: None,
             friction_loads: Some(sparse(ptc.transpose().to_owned())?),
+            modal: Default::default(),
         };
         let columns = PairColumns {
             factor: self.factor.clone(),

@@ -303,6 +303,7 @@ fn a_reduced_solve_on_a_complete_basis_has_the_full_condition_numbers() {
         fk: sparse(&Rng(9).mat(12, 2.0)),
         t: None,
         friction_loads: None,
+        modal: Default::default(),
     };
     let mu = 0.4;
     let full = Dense.solve_frictional(&op, mu, &band(1e3)).unwrap();
