@@ -144,6 +144,7 @@ fn the_comparison_counts_missed_false_and_shifted_modes() {
         let needs = squeal::core::operator::needs_condition(
             reference.lambda[i],
             reference.backward_error[i],
+            reference.cond_floor[i],
         );
         assert_eq!(
             !reference.cond[i].is_nan(),

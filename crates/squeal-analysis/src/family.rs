@@ -226,6 +226,7 @@ pub fn sweep_point(
                 backward_error: modes.backward_error[i],
                 cond: modes.cond[i],
                 error_bound: modes.error_bound[i],
+                cond_floor: modes.cond_floor[i],
                 signature: signature(reference.mphi.as_ref(), &u),
             }
         })

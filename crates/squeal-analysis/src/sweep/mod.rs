@@ -68,6 +68,13 @@ pub struct SweepMode {
         deserialize_with = "crate::jsonl::null_as_nan"
     )]
     pub error_bound: f64,
+    /// The smallest condition number the eigenvalue can have
+    /// (`ComplexModes::cond_floor`); NaN in checkpoints written before it was recorded.
+    #[serde(
+        default = "crate::jsonl::nan",
+        deserialize_with = "crate::jsonl::null_as_nan"
+    )]
+    pub cond_floor: f64,
     /// Coefficients on the reference modes of tracking (the free-interface modes of a
     /// scene): (re, im) pairs.
     pub signature: Vec<[f64; 2]>,
@@ -82,7 +89,13 @@ impl SweepMode {
     /// The stability class and the bound of the real part it was decided by
     /// ([`squeal_core::operator::classify`]).
     pub fn verdict(&self, dvr_margin: f64) -> Verdict {
-        classify(self.lambda(), self.backward_error, self.cond, dvr_margin)
+        classify(
+            self.lambda(),
+            self.backward_error,
+            self.cond,
+            self.cond_floor,
+            dvr_margin,
+        )
     }
 
     /// The stability class ([`SweepMode::verdict`]).
@@ -116,6 +129,7 @@ impl PartialEq for SweepMode {
             && same_number(self.backward_error, o.backward_error)
             && same_number(self.cond, o.cond)
             && same_number(self.error_bound, o.error_bound)
+            && same_number(self.cond_floor, o.cond_floor)
             && self.signature == o.signature
     }
 }
@@ -407,6 +421,7 @@ mod tests {
             backward_error: 0.0,
             cond: f64::NAN,
             error_bound: f64::NAN,
+            cond_floor: f64::NAN,
             signature: sig.iter().map(|&x| [x, 0.0]).collect(),
         }
     }

@@ -26,6 +26,11 @@ pub struct ComplexModes {
     /// First-order estimate of the relative forward error of each eigenvalue,
     /// `|lambda - lambda_exact| / |lambda| <~ cond * backward_error`; NaN where `cond` is.
     pub error_bound: Vec<f64>,
+    /// The smallest condition number each eigenvalue can have given the matrix norms
+    /// (`(|l|^2 ||M|| + |l| ||C|| + ||K||) / (|l| (2 |l| ||M||_2 + ||C||_2))`, at least
+    /// [`MIN_COND`]): a real part within it times the backward error is neutral without
+    /// computing `cond` ([`classify`]).
+    pub cond_floor: Vec<f64>,
     /// The left eigenvectors behind `cond` (`y^H Q(lambda) = 0`), one column per mode,
     /// unit 2-norm except inside a cluster of (nearly) equal eigenvalues, where they are
     /// bi-orthogonalized against the right vectors; `None` when not computed.
@@ -56,6 +61,7 @@ impl ComplexModes {
             self.lambda[i],
             self.backward_error[i],
             self.cond[i],
+            self.cond_floor.get(i).copied().unwrap_or(f64::NAN),
             dvr_margin,
         )
     }
@@ -148,14 +154,23 @@ pub struct Verdict {
 
 /// Whether the class of an eigenvalue with this backward error depends on its condition
 /// number: a real part between the smallest bound any condition gives
-/// (`MIN_COND x eta x |lambda|`) and the square-root rule (`SQRT_RULE x sqrt(eta) x
-/// |lambda|`), `eta` the backward error floored at [`BACKWARD_ERROR_FLOOR`]. Full-order
-/// solves compute `cond` for these modes only (see
-/// [`Condition::Auto`](crate::qep::Condition)).
-pub fn needs_condition(lambda: crate::c64, backward_error: f64) -> bool {
+/// (`cond_floor x eta x |lambda|`, [`ComplexModes::cond_floor`]; NaN for
+/// [`MIN_COND`]) and the square-root rule (`SQRT_RULE x sqrt(eta) x |lambda|`), `eta`
+/// the backward error floored at [`BACKWARD_ERROR_FLOOR`]. Full-order solves compute
+/// `cond` for these modes only (see [`Condition::Auto`](crate::qep::Condition)).
+pub fn needs_condition(lambda: crate::c64, backward_error: f64, cond_floor: f64) -> bool {
     let e = floored(backward_error);
     let (re, a) = (lambda.re.abs(), lambda.norm());
-    re > MIN_COND * e * a && re < SQRT_RULE * e.sqrt() * a
+    re > least_cond(cond_floor) * e * a && re < SQRT_RULE * e.sqrt() * a
+}
+
+/// The smallest condition number to count on: `cond_floor`, at least [`MIN_COND`].
+fn least_cond(cond_floor: f64) -> f64 {
+    if cond_floor.is_nan() {
+        MIN_COND
+    } else {
+        cond_floor.max(MIN_COND)
+    }
 }
 
 fn floored(backward_error: f64) -> f64 {
@@ -177,16 +192,24 @@ fn floored(backward_error: f64) -> f64 {
 /// square-root rule `b = sqrt(eta) |lambda|`. Without `cond` (NaN): a real part within
 /// `MIN_COND x eta x |lambda|` is neutral (no condition number is smaller), one beyond
 /// `SQRT_RULE x sqrt(eta) x |lambda|` is decided by its sign (bound NaN), and one in
-/// between ([`needs_condition`]) is neutral within that conservative bound.
-pub fn classify(lambda: crate::c64, backward_error: f64, cond: f64, dvr_margin: f64) -> Verdict {
+/// between ([`needs_condition`]) is neutral within that conservative bound. `cond_floor`
+/// ([`ComplexModes::cond_floor`], NaN when unknown) replaces `MIN_COND` when larger.
+pub fn classify(
+    lambda: crate::c64,
+    backward_error: f64,
+    cond: f64,
+    cond_floor: f64,
+    dvr_margin: f64,
+) -> Verdict {
     let e = floored(backward_error);
     let (re, a) = (lambda.re, lambda.norm());
+    let least = least_cond(cond_floor);
     let re_bound = if cond.is_finite() {
         cond * e * a
     } else if cond.is_infinite() {
         e.sqrt() * a
-    } else if re.abs() <= MIN_COND * e * a {
-        MIN_COND * e * a
+    } else if re.abs() <= least * e * a {
+        least * e * a
     } else if re.abs() >= SQRT_RULE * e.sqrt() * a {
         f64::NAN
     } else {

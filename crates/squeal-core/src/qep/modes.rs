@@ -13,6 +13,13 @@ use crate::{c64, Error, Result};
 use faer::Mat;
 use std::time::Instant;
 
+/// Size above which [`Condition::Auto`] does not compute `cond` even for the modes whose
+/// class depends on it: a complex sparse LU of `Q(lambda)` per mode (faer's, in its
+/// column ordering) took 29 s and 4.6 GB at 45k DOFs, and runs out of 24 GB at the
+/// default rig's 172k. Those modes then stay neutral within the square-root rule
+/// ([`crate::operator::classify`]), noted in the solve's report.
+pub const CONDITION_WHERE_NEEDED_MAX_DIM: usize = 50_000;
+
 /// Relative size of `Im(lambda)` below which a root counts as real (not an oscillating
 /// mode): `|Im(lambda)| <= REAL_ROOT_REL |lambda|`. Such roots are dropped by
 /// [`finish_modes`].
@@ -296,11 +303,21 @@ fn finish_terms(
         Some(_) => condition::condition_from_products(&norms, &lam, &products, &be),
         None => (vec![f64::NAN; lam.len()], vec![f64::NAN; lam.len()]),
     };
+    let cond_floor: Vec<f64> = lam.iter().map(|&l| norms.cond_floor(l)).collect();
     if let Some(problem) = where_needed {
         let need: Vec<usize> = (0..lam.len())
-            .filter(|&j| needs_condition(lam[j], be[j]))
+            .filter(|&j| needs_condition(lam[j], be[j], cond_floor[j]))
             .collect();
-        if !need.is_empty() {
+        if !need.is_empty() && n > CONDITION_WHERE_NEEDED_MAX_DIM {
+            info.notes.push(format!(
+                "cond not computed for the {} of {} modes whose stability class depends on \
+                 it: {n} DOFs is above {CONDITION_WHERE_NEEDED_MAX_DIM}, where a complex \
+                 sparse LU of Q(lambda) per mode costs more than the solve (they stay \
+                 neutral within the square-root rule; --condition forces it)",
+                need.len(),
+                lam.len()
+            ));
+        } else if !need.is_empty() {
             let t = Instant::now();
             let q = problem.qep()?;
             let lam_n: Vec<c64> = need.iter().map(|&j| lam[j]).collect();
@@ -339,6 +356,7 @@ fn finish_terms(
         backward_error: be,
         cond,
         error_bound,
+        cond_floor,
         left_vectors: left,
         info,
     })

@@ -8,14 +8,47 @@ use crate::operator::{FrictionalOperator, Qep};
 use crate::{c64, SparseMat, SparseRef};
 use faer::MatRef;
 
-/// The three norms entering the backward error.
+/// The three norms entering the backward error (1-norms), and upper bounds of the
+/// 2-norms of `M` and `C` (`sqrt(||X||_1 ||X||_inf)`) for the smallest condition number
+/// an eigenvalue can have ([`QepNorms::cond_floor`]).
 pub(super) struct QepNorms {
     pub(super) m: f64,
     pub(super) c: f64,
     pub(super) k: f64,
+    pub(super) m2: f64,
+    pub(super) c2: f64,
+}
+
+/// `||A||_inf`, the largest row sum of `|a_ij|`.
+fn norm_inf(a: SparseRef<'_>) -> f64 {
+    let mut rows = vec![0.0f64; a.nrows()];
+    for j in 0..a.ncols() {
+        for (&i, v) in a.row_idx_of_col_raw(j).iter().zip(a.val_of_col(j)) {
+            rows[i] += v.abs();
+        }
+    }
+    rows.into_iter().fold(0.0, f64::max)
 }
 
 impl QepNorms {
+    /// The smallest condition number (`ComplexModes::cond`) an eigenvalue `lambda` can
+    /// have: `|y^H Q'(lambda) x| <= ||y|| ||x|| (2 |lambda| ||M||_2 + ||C||_2)`, so
+    /// `cond >= (|l|^2 ||M|| + |l| ||C|| + ||K||) / (|l| (2 |l| ||M||_2 + ||C||_2))`, and
+    /// never below [`MIN_COND`](crate::operator::MIN_COND). For a finite element model,
+    /// whose `||K|| / ||M||` is the square of its highest frequency, this is large for the
+    /// modes of the band.
+    pub(super) fn cond_floor(&self, lambda: c64) -> f64 {
+        let al = lambda.norm();
+        let den = al * (2.0 * al * self.m2 + self.c2);
+        let w = al * al * self.m + al * self.c + self.k;
+        let floor = if den > 0.0 { w / den } else { f64::NAN };
+        if floor.is_finite() {
+            floor.max(crate::operator::MIN_COND)
+        } else {
+            crate::operator::MIN_COND
+        }
+    }
+
     /// The backward error `||r|| / ((|l|^2 ||M|| + |l| ||C|| + ||K||) ||u||)` from the
     /// residual norm `num` and the vector norm `un`; `0` for a zero residual on a zero
     /// scale, infinite for a nonzero one.
@@ -32,10 +65,13 @@ impl QepNorms {
     }
 
     pub(super) fn of(qep: &Qep) -> Self {
+        let two = |a: SparseRef<'_>| (norm1(a) * norm_inf(a)).sqrt();
         Self {
             m: norm1(qep.m.as_ref()),
             c: qep.c.as_ref().map_or(0.0, |c| norm1(c.as_ref())),
             k: norm1(qep.k.as_ref()),
+            m2: two(qep.m.as_ref()),
+            c2: qep.c.as_ref().map_or(0.0, |c| two(c.as_ref())),
         }
     }
 }
@@ -111,10 +147,17 @@ impl<'a> QepTerms<'a> {
     }
 
     pub(super) fn norms(&self) -> QepNorms {
+        // ||sum a_i A_i||_inf <= sum |a_i| ||A_i||_inf: an upper bound suits the floor
+        let inf = |terms: &[(SparseRef<'_>, f64)]| -> f64 {
+            terms.iter().map(|(a, s)| s.abs() * norm_inf(*a)).sum()
+        };
+        let (m, c) = (self.norm1(&self.m), self.norm1(&self.c));
         QepNorms {
-            m: self.norm1(&self.m),
-            c: self.norm1(&self.c),
+            m,
+            c,
             k: self.norm1(&self.k),
+            m2: (m * inf(&self.m)).sqrt(),
+            c2: (c * inf(&self.c)).sqrt(),
         }
     }
 }

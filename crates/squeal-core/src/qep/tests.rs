@@ -670,7 +670,11 @@ fn operator_modes_are_checked_on_the_parts_like_the_assembled_operator() {
         // condition numbers added afterwards equal those of the solve that computed them
         assert!(parts.left_vectors.is_none());
         for j in 0..parts.len() {
-            let needs = crate::operator::needs_condition(parts.lambda[j], parts.backward_error[j]);
+            let needs = crate::operator::needs_condition(
+                parts.lambda[j],
+                parts.backward_error[j],
+                parts.cond_floor[j],
+            );
             assert_eq!(!parts.cond[j].is_nan(), needs, "mu {mu}, mode {j}");
         }
         add_condition(&op, mu, &mut parts).unwrap();
