@@ -92,7 +92,7 @@ case "$name" in
     done
     resume=()
     [ -d out/brake/sweep-w ] && resume=(--resume)
-    $squeal sweep param --operator out/brake/operator-sym --param W --from 20 --to 100 \
+    $squeal sweep param --operator out/brake/operator-sym --param W --from 45 --to 100 \
       --step 5 --mu 0 --band 100:300 --out out/brake/sweep-w "${resume[@]}" ;;
   *)
     sed -n '2,24p' "$0"

@@ -334,11 +334,11 @@ impl LineFig<'_> {
         let nl = marked(Mark::Neutral);
         let ann = chart.draw_series(
             nl.iter()
-                .map(|p| Circle::new(*p, 6, NEUTRAL.stroke_width(2))),
+                .map(|p| Circle::new(*p, 5, NEUTRAL.stroke_width(1))),
         )?;
         if let (Some(label), false) = (&self.opts.neutral_label, nl.is_empty()) {
             ann.label(label.clone())
-                .legend(|(x, y)| Circle::new((x + 7, y), 5, NEUTRAL.stroke_width(2)));
+                .legend(|(x, y)| Circle::new((x + 7, y), 5, NEUTRAL.stroke_width(1)));
             legend = true;
         }
         let hl = marked(Mark::Highlight);

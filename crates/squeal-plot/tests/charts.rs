@@ -400,6 +400,39 @@ fn line_chart_markers_highlights_and_lines() {
 }
 
 #[test]
+fn line_chart_rings_neutral_points_and_refuses_a_wrong_mask() {
+    let tmp = temp_dir("line-neutral");
+    let stem = tmp.path().join("classes");
+    let s = Series {
+        name: String::new(),
+        points: vec![(1.0, -2.0), (2.0, 0.0), (3.0, 1e-9), (4.0, 3.0)],
+        style: SeriesStyle::Markers,
+        neutral: vec![false, true, true, false],
+        highlight: vec![false, false, false, true],
+    };
+    let opts = ChartOptions {
+        hline: Some(0.0),
+        highlight_label: Some("unstable".into()),
+        neutral_label: Some("neutral within the error bound".into()),
+        ..ChartOptions::default()
+    };
+    let files = line_chart(&stem, "Classes", "x", "y", std::slice::from_ref(&s), &opts).unwrap();
+    let svg = check_outputs(&stem, &files, CHART_SIZE);
+    // a filled marker for each point but the highlighted one, a red one for it, and two
+    // rings (plus the legend's): the rings have no fill
+    assert_eq!(svg.count_attr("circle", "fill", "#1F77B4"), 3);
+    assert_eq!(svg.count_attr("circle", "fill", "#D62728"), 1);
+    assert_eq!(svg.count_attr("circle", "stroke", "#FF8C00"), 3);
+    assert!(svg.has_text("neutral within the error bound"));
+    let wrong = Series {
+        neutral: vec![true],
+        ..s
+    };
+    let err = line_chart(&stem, "Classes", "x", "y", &[wrong], &opts).unwrap_err();
+    assert!(matches!(err, PlotError::InvalidInput { .. }), "{err}");
+}
+
+#[test]
 fn line_chart_custom_size_and_line_markers() {
     let tmp = temp_dir("line-size");
     let dir = tmp.path();
