@@ -1005,3 +1005,126 @@ fn default_scene_acceptance_against_full_arpack() {
     );
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// The energy-norm error bound of reduced modes (`squeal_core::reduction::energy_bounds`)
+/// on the coarse rig at mu = 0.7: for every mode it tightens it still holds against the
+/// full-order eigenvalue, it is tighter than the Euclidean bound, and it is what lets
+/// `enriched` certify the coupled mode unstable (its Euclidean bound is wider than its
+/// real part).
+#[test]
+fn energy_bounds_hold_and_certify_the_coupled_mode_of_a_reduced_solve() {
+    use squeal::core::reduction::{energy_bounds, EnergyWeight};
+    let reg = squeal::registry();
+    let mu = 0.7;
+    let fmax = 4000.0;
+    let prep = Prepared::new(&reg, coarse(), "coarse").unwrap();
+    let eq = prep.equilibrium(&reg, "lcp", "lagrange", mu).unwrap();
+    let op = prep.operator(&eq.eq.active).unwrap();
+    let reference = solver(&reg, "arpack")
+        .solve_frictional(&op, mu, &params(fmax))
+        .unwrap();
+    let unstable: Vec<usize> = (0..reference.len())
+        .filter(|&i| reference.is_unstable(i, 0.0))
+        .collect();
+    assert!(!unstable.is_empty(), "the coarse rig flutters at mu = 0.7");
+    let red = ReducedOperator::new(&op, build_basis(&reg, "enriched", &[], &op, mu, fmax)).unwrap();
+    let euclid = red
+        .solve(
+            &op,
+            mu,
+            solver(&reg, "dense").as_ref(),
+            &params(fmax * 1.01),
+        )
+        .unwrap()
+        .modes;
+    assert!(
+        euclid.left_vectors.is_some(),
+        "reduced solves keep left vectors"
+    );
+    // the weights: the operator's own stiffness K_c (its real-mode pair), and the free
+    // model's factor of K that `enriched`'s model stage holds
+    let mut by_pair = euclid.clone();
+    let tightened = energy_bounds(&op, mu, &mut by_pair, EnergyWeight::Pair).unwrap();
+    assert!(
+        tightened > 0,
+        "some class was left open by the Euclidean bound"
+    );
+    let plugin = reg.bases.create("enriched", &Params::new()).unwrap();
+    let stage = prep
+        .model_stage(
+            plugin.as_ref(),
+            solver(&reg, "arpack").as_ref(),
+            &params(fmax),
+        )
+        .unwrap()
+        .expect("`enriched` has a model stage");
+    let free = plugin
+        .stage_factor(&stage)
+        .expect("the stage holds the free factor");
+    let mut energy = euclid.clone();
+    assert_eq!(
+        energy_bounds(&op, mu, &mut energy, EnergyWeight::FreeModel(&free)).unwrap(),
+        tightened
+    );
+    // the nearest reference eigenvalue of each reduced mode
+    let actual = |l: c64| {
+        reference
+            .lambda
+            .iter()
+            .map(|r| (l - r).norm() / r.norm())
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut ratios = Vec::new();
+    for j in 0..energy.len() {
+        let e = euclid.error_bound[j];
+        let err = actual(energy.lambda[j]);
+        for (what, w) in [
+            ("K_c", by_pair.error_bound[j]),
+            ("free K", energy.error_bound[j]),
+        ] {
+            assert!(
+                w <= e,
+                "mode {j}: {what} bound {w:.2e} above the Euclidean {e:.2e}"
+            );
+            assert!(
+                w >= err,
+                "mode {j} ({:.1} Hz): {what} bound {w:.2e} below the actual error {err:.2e}",
+                energy.freq_hz[j]
+            );
+            if w < e {
+                ratios.push(e / w);
+            }
+        }
+        if by_pair.error_bound[j] < e {
+            println!(
+                "{:>8.1} Hz  DvR {:>9.2e}  actual {err:.1e}  Euclidean {e:.1e}  K_c {:.1e}  \
+                 free K {:.1e}",
+                energy.freq_hz[j], energy.dvr[j], by_pair.error_bound[j], energy.error_bound[j]
+            );
+        }
+    }
+    assert!(
+        ratios.iter().any(|&r| r > 3.0),
+        "the energy norm tightens by more than 3x somewhere: {ratios:?}"
+    );
+    for &u in &unstable {
+        let (f, l) = (reference.freq_hz[u], reference.lambda[u]);
+        // the nearest eigenvalue, not the nearest frequency: the stable partner of the
+        // coupled pair has almost the same frequency
+        let j = (0..energy.len())
+            .min_by(|&a, &b| {
+                (energy.lambda[a] - l)
+                    .norm()
+                    .total_cmp(&(energy.lambda[b] - l).norm())
+            })
+            .unwrap();
+        assert!(
+            energy.is_unstable(j, 0.0),
+            "the coupled mode at {f:.1} Hz (reduced {:.1} Hz, DvR {:.2e}, bound {:.2e}) is \
+             certified unstable on `enriched`",
+            energy.freq_hz[j],
+            energy.dvr[j],
+            energy.error_bound[j]
+        );
+    }
+}

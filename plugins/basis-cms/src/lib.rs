@@ -47,6 +47,7 @@
 //!   `full` way.
 
 use squeal_core::faer::Mat;
+use squeal_core::linalg::Cholesky;
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{m_orthonormalize, DEFAULT_RANK_TOL};
 use squeal_core::{
@@ -189,6 +190,10 @@ impl ReductionBasis for CmsBasis {
             FreeInterface::new(k, m, pairs, &modes)?
         };
         Ok(Some(Arc::new(fi)))
+    }
+
+    fn stage_factor(&self, stage: &ModelStage) -> Option<Arc<Cholesky>> {
+        stage.downcast_ref::<FreeInterface>().map(|f| f.factor())
     }
 
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {

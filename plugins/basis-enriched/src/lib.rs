@@ -41,7 +41,7 @@
 //! - `rank_tol` (default [`DEFAULT_RANK_TOL`]): relative rank cut of the
 //!   orthonormalization.
 
-use squeal_core::linalg::norm2;
+use squeal_core::linalg::{norm2, Cholesky};
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
     coupled_real_modes_on, m_orthonormal_extend, m_orthonormalize, m_svd_compress, real_modes_cost,
@@ -143,6 +143,12 @@ impl ReductionBasis for EnrichedBasis {
             }
         }
         Ok(())
+    }
+
+    fn stage_factor(&self, stage: &ModelStage) -> Option<Arc<Cholesky>> {
+        stage
+            .downcast_ref::<EnrichedStage>()
+            .map(|s| s.pairs.factor())
     }
 
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {

@@ -48,7 +48,7 @@
 //!   orthonormalization.
 
 use squeal_core::faer::Mat;
-use squeal_core::linalg::hcat;
+use squeal_core::linalg::{hcat, Cholesky};
 use squeal_core::params::{fraction, positive};
 use squeal_core::reduction::{
     coupled_real_modes_on, expand, from_free_dofs, m_orthonormalize, real_modes_cost,
@@ -59,6 +59,7 @@ use squeal_core::{
     Basis, BasisRequest, EigenParams, Error, FreeModel, ModelStage, Params, ReductionBasis,
     Registry, Result,
 };
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Name under which the basis is registered.
@@ -154,6 +155,10 @@ impl ReductionBasis for ResidueBasis {
 
     fn prepare(&self, free: &FreeModel<'_>) -> Result<Option<ModelStage>> {
         PairSolves::stage(free)
+    }
+
+    fn stage_factor(&self, stage: &ModelStage) -> Option<Arc<Cholesky>> {
+        PairSolves::in_stage(Some(stage.as_ref())).map(PairSolves::factor)
     }
 
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis> {

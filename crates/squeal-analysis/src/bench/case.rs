@@ -7,9 +7,11 @@ use crate::pipeline::{PipelineError, Result};
 use crate::profile::max_opt;
 use serde::{Deserialize, Serialize};
 use squeal_core::contact::BasisRequest;
+use squeal_core::linalg::Cholesky;
 use squeal_core::operator::{ComplexModes, Stability};
-use squeal_core::reduction::ReducedOperator;
+use squeal_core::reduction::{energy_bounds_on, ReducedOperator};
 use squeal_core::{EigenParams, EigenSolver, FrictionalOperator, Params, Registry};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// One benchmark run: one (basis, parameters, eigen solver) on one operator at one mu.
@@ -321,7 +323,13 @@ impl Runner<'_> {
 
     /// Builds basis `basis` with parameters `p` on the case's operator (its model stage
     /// from the runner's stages, if it has one) and projects the operator on it.
-    fn reduced_operator(&self, basis: &str, p: &Params) -> Result<ReducedOperator> {
+    /// Returns it with the free model's factor that the stage holds (for the energy-norm
+    /// error bounds of the modes solved on it).
+    fn reduced_operator(
+        &self,
+        basis: &str,
+        p: &Params,
+    ) -> Result<(ReducedOperator, Option<Arc<Cholesky>>)> {
         let (op, mu, opts) = (self.op, self.mu, self.opts);
         let plugin = self
             .registry
@@ -330,12 +338,11 @@ impl Runner<'_> {
             .map_err(core(format!("basis `{basis}`")))?;
         let modal = eigen_solver(self.registry, &opts.modal)?;
         let dense = eigen_solver(self.registry, "dense")?;
-        let stage = plugin.stage_key(opts.band_hz[1]).and_then(|key| {
-            self.stages
-                .iter()
-                .find(|s| s.key == key)
-                .map(|s| s.stage.as_ref())
-        });
+        let stage = plugin
+            .stage_key(opts.band_hz[1])
+            .and_then(|key| self.stages.iter().find(|s| s.key == key));
+        let free = stage.and_then(|s| plugin.stage_factor(&s.stage));
+        let stage = stage.map(|s| s.stage.as_ref());
         let req = BasisRequest {
             op,
             mu,
@@ -348,7 +355,8 @@ impl Runner<'_> {
         };
         let b = squeal_core::contact::build_basis(plugin.as_ref(), &req)
             .map_err(core(format!("basis `{basis}` at mu = {mu}")))?;
-        ReducedOperator::new(op, b).map_err(core(format!("projection on `{basis}`")))
+        let red = ReducedOperator::new(op, b).map_err(core(format!("projection on `{basis}`")))?;
+        Ok((red, free))
     }
 
     /// Basis `basis` with parameters `p` (labelled `label`) built once, then every eigen
@@ -360,7 +368,7 @@ impl Runner<'_> {
         let built = self.reduced_operator(basis, p);
         let setup_s = t.elapsed().as_secs_f64();
         let setup_peak = meter.peak_mb();
-        let red = match built {
+        let (red, free) = match built {
             Ok(r) => r,
             Err(e) => {
                 for eigen in &opts.eigens {
@@ -382,14 +390,21 @@ impl Runner<'_> {
                 ..self.blank(basis, label, eigen)
             };
             let t = Instant::now();
-            match eigen_solver(self.registry, eigen).and_then(|s| {
-                red.solve(op, mu, s.as_ref(), &self.params)
-                    .map_err(core(format!("`{eigen}` on basis `{basis}` at mu = {mu}")))
-            }) {
-                Ok(r) => {
+            let solved = eigen_solver(self.registry, eigen).and_then(|s| {
+                let at = format!("`{eigen}` on basis `{basis}` at mu = {mu}");
+                let mut r = red
+                    .solve(op, mu, s.as_ref(), &self.params)
+                    .map_err(core(at.clone()))?;
+                let t = Instant::now();
+                energy_bounds_on(free.as_deref(), op, mu, &mut r.modes)
+                    .map_err(core(format!("energy-norm error bounds of {at}")))?;
+                Ok((r, t.elapsed().as_secs_f64()))
+            });
+            match solved {
+                Ok((r, bound_s)) => {
                     run.solve_s = t.elapsed().as_secs_f64();
                     run.reduced_solve_s = Some(r.solve_time_s);
-                    run.expansion_s = Some(r.expansion_time_s);
+                    run.expansion_s = Some(r.expansion_time_s + bound_s);
                     run.errors = compare(self.reference, &r.modes, opts.band_hz, opts.dvr_margin);
                 }
                 Err(e) => {

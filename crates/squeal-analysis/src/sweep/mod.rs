@@ -93,6 +93,7 @@ impl SweepMode {
             self.lambda(),
             self.backward_error,
             self.cond,
+            self.error_bound,
             self.cond_floor,
             dvr_margin,
         )

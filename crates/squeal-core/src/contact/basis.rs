@@ -196,6 +196,13 @@ pub trait ReductionBasis: Send + Sync {
         let _ = stage;
         Ok(())
     }
+    /// The Cholesky factor of the free model's `K` that this basis's model stage holds,
+    /// if any: the callers bound the errors of the modes solved on the basis in its
+    /// energy norm with it ([`crate::reduction::energy_bounds`]). The default has none.
+    fn stage_factor(&self, stage: &ModelStage) -> Option<Arc<crate::linalg::Cholesky>> {
+        let _ = stage;
+        None
+    }
     /// Builds the basis described by `request`.
     fn build(&self, request: &BasisRequest<'_>) -> Result<Basis>;
 }

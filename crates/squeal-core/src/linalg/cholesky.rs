@@ -96,6 +96,15 @@ pub struct Cholesky {
     n: usize,
 }
 
+impl std::fmt::Debug for Cholesky {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Cholesky")
+            .field("n", &self.n)
+            .field("factor_entries", &self.factor_entries())
+            .finish()
+    }
+}
+
 impl Cholesky {
     /// Factorizes `a`; `what` names the matrix in errors.
     pub fn new(a: SparseRef<'_>, what: &str) -> Result<Self> {

@@ -68,6 +68,7 @@ impl RealModePair {
             m,
             source: source.into(),
             built: OnceLock::new(),
+            factor: OnceLock::new(),
         }))
     }
 }
@@ -84,6 +85,9 @@ pub struct LazyPair {
     pub source: String,
     /// The pair, built by [`crate::reduction::real_mode_pair`].
     pub built: OnceLock<std::result::Result<Arc<ModalPair>, String>>,
+    /// The Cholesky factor of the pair's `K_s`, built on first use by
+    /// [`crate::reduction::energy_bounds`].
+    pub factor: OnceLock<std::result::Result<Arc<crate::linalg::Cholesky>, String>>,
 }
 
 /// A symmetric positive definite pair `(K_s, M_s)` ([`RealModePair`]).

@@ -24,7 +24,9 @@ pub struct ComplexModes {
     /// module for what it promises and where it fails).
     pub cond: Vec<f64>,
     /// First-order estimate of the relative forward error of each eigenvalue,
-    /// `|lambda - lambda_exact| / |lambda| <~ cond * backward_error`; NaN where `cond` is.
+    /// `|lambda - lambda_exact| / |lambda| <~ cond * backward_error`, or, for a mode of a
+    /// reduced solve that [`crate::reduction::energy_bounds`] tightened, the same bound
+    /// in an energy norm; NaN where `cond` is.
     pub error_bound: Vec<f64>,
     /// The smallest condition number each eigenvalue can have given the matrix norms
     /// (`(|l|^2 ||M|| + |l| ||C|| + ||K||) / (|l| (2 |l| ||M||_2 + ||C||_2))`, at least
@@ -61,6 +63,7 @@ impl ComplexModes {
             self.lambda[i],
             self.backward_error[i],
             self.cond[i],
+            self.error_bound[i],
             self.cond_floor.get(i).copied().unwrap_or(f64::NAN),
             dvr_margin,
         )
@@ -184,8 +187,12 @@ fn floored(backward_error: f64) -> f64 {
 /// The stability class of an eigenvalue `lambda` (1/s) with its backward error and
 /// condition number on the full operator.
 ///
-/// The forward error bound of the real part is `b = cond x eta x |lambda|` (`eta` the
-/// backward error, at least [`BACKWARD_ERROR_FLOOR`]): the mode is **unstable** when
+/// The forward error bound of the real part is `b = error_bound x |lambda|`, at least
+/// `cond x BACKWARD_ERROR_FLOOR x |lambda|` (`error_bound = cond x eta`, `eta` the backward
+/// error, or for a reduced mode the smaller energy-norm bound of
+/// [`crate::reduction::energy_bounds`]; `cond x eta` when `error_bound` is NaN): the
+/// mode is
+/// **unstable** when
 /// `Re(lambda) > b` and its divergence rate `Re / Im` exceeds `dvr_margin` (a physical
 /// margin; 0 for none), **stable** when `Re(lambda) < -b`, **neutral** otherwise. An
 /// infinite `cond` (a defective eigenvalue, where the first-order bound fails) takes the
@@ -198,13 +205,16 @@ pub fn classify(
     lambda: crate::c64,
     backward_error: f64,
     cond: f64,
+    error_bound: f64,
     cond_floor: f64,
     dvr_margin: f64,
 ) -> Verdict {
     let e = floored(backward_error);
     let (re, a) = (lambda.re, lambda.norm());
     let least = least_cond(cond_floor);
-    let re_bound = if cond.is_finite() {
+    let re_bound = if cond.is_finite() && error_bound.is_finite() {
+        error_bound.max(cond * BACKWARD_ERROR_FLOOR) * a
+    } else if cond.is_finite() {
         cond * e * a
     } else if cond.is_infinite() {
         e.sqrt() * a

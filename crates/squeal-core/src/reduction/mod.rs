@@ -49,6 +49,7 @@ use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef, Par};
 
 mod candidates;
+mod energy;
 mod growing;
 mod mac;
 mod modal;
@@ -67,6 +68,7 @@ pub use candidates::{
     coupled_real_modes, coupled_real_modes_on, friction_load_directions, real_modes_cost,
     real_modes_seed,
 };
+pub use energy::{energy_bounds, energy_bounds_on, EnergyWeight};
 pub use growing::GrowingBasis;
 pub use mac::mac_real_complex;
 pub use modal::{real_mode_pair, symmetric_part, PairRef};

@@ -106,6 +106,11 @@ impl PairSolves {
         Ok(Some(Arc::new(Self::new(free)?)))
     }
 
+    /// The Cholesky factor of the free model's `K` the pair solves run on.
+    pub fn factor(&self) -> Arc<Cholesky> {
+        self.factor.clone()
+    }
+
     /// The pair solves in a basis request's model stage, if that is what it holds.
     pub fn in_stage(stage: Option<&(dyn std::any::Any + Send + Sync)>) -> Option<&Self> {
         stage.and_then(|s| s.downcast_ref::<Self>())

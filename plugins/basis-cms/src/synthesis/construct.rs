@@ -29,6 +29,11 @@ fn solve_blocks(factor: &Cholesky, x: &mut Mat<f64>) {
 const BLOCK: usize = 64;
 
 impl FreeInterface {
+    /// The Cholesky factor of the free model's `K` the synthesis expands with.
+    pub fn factor(&self) -> Arc<Cholesky> {
+        self.factor.clone()
+    }
+
     /// Builds the free-interface data of the model `(k, m)` (free DOFs, `K` positive
     /// definite) for the candidate `pairs`, with the free-interface `modes` (of the same
     /// `(K, M)`, `M`-orthonormal, e.g. from an [`EigenSolver`](squeal_core::EigenSolver) up to a
