@@ -25,12 +25,12 @@
 //! - an operator read from files: `W = K_s`, its real-mode pair's stiffness
 //!   ([`super::real_mode_pair`]), factorized once and kept with the pair.
 //!
-//! Only the modes whose class the Euclidean bound leaves open get one (a real part not
-//! zero and within that bound): two solves each.
+//! Only the modes whose class the Euclidean bound leaves open get one (a real part within
+//! that bound and above the round-off that no bound resolves): two solves each.
 
 use super::real_mode_pair;
 use crate::linalg::{spmv, spmv_complex, Cholesky};
-use crate::operator::{ComplexModes, FrictionalOperator, RealModePair};
+use crate::operator::{ComplexModes, FrictionalOperator, RealModePair, BACKWARD_ERROR_FLOOR};
 use crate::{c64, Error, Result};
 use std::sync::Arc;
 
@@ -163,10 +163,13 @@ pub fn energy_bounds(
     if modes.vectors.nrows() != n || y.nrows() != n {
         return Ok(0);
     }
+    // a real part below `cond x BACKWARD_ERROR_FLOOR x |lambda|` stays neutral whatever
+    // the bound (round-off, `classify`): no solve for it
     let open: Vec<usize> = (0..modes.len())
         .filter(|&j| {
-            let (l, b) = (modes.lambda[j], modes.error_bound[j]);
-            l.re != 0.0 && b.is_finite() && l.re.abs() <= b * l.norm()
+            let (l, b, c) = (modes.lambda[j], modes.error_bound[j], modes.cond[j]);
+            let re = l.re.abs();
+            b.is_finite() && re <= b * l.norm() && re > c * BACKWARD_ERROR_FLOOR * l.norm()
         })
         .collect();
     if open.is_empty() {
