@@ -280,7 +280,7 @@ fn m_norm(m: squeal::core::SparseRef<'_>, x: &Mat<f64>) -> f64 {
         .sqrt()
 }
 
-/// The pitfall of METHODS.md section 4, written out: `G = V^T M V`, `G = W L W^T`, keep
+/// The pitfall of a raw Gram-matrix diagonalization, written out: `G = V^T M V`, `G = W L W^T`, keep
 /// the eigenpairs with `l_i > tol l_max`, basis `V W_r L_r^-1/2`. With `normalize`, the
 /// columns are first scaled to unit `M` norm.
 fn gram_diagonalization(

@@ -1,4 +1,4 @@
-//! The constrained frictional operator of one active set (METHODS.md section 2).
+//! The constrained frictional operator of one active set.
 //!
 //! Linearized about the sliding equilibrium with the active pairs bilateral and sliding:
 //! `(lambda^2 M + lambda C + K) u = (P~n + mu P~t)^T r`, `P~n u = 0`. With the slave-normal

@@ -1,4 +1,4 @@
-//! The frictional operator against its oracles (METHODS.md section 6) on a tiny model
+//! The frictional operator against its oracles on a tiny model
 //! built through the production code paths: two hexahedral blocks (a "disc" block clamped
 //! at its bottom, a "pin" block clamped at its top) touching at z = 0 with 3 x 3
 //! node-to-node pairs, assembled by squeal-fe, paired by `ContactSet::from_pairs`,

@@ -6,7 +6,7 @@
 //! up to `cutoff_factor x` the band top, `M_c`-orthonormal — the
 //! projection commercial codes use (QRDAMP-style), the baseline of the comparison.
 //! Truncated near the band top it misses the friction-induced deformation and
-//! over-predicts growth rates (METHODS.md section 4); the backward errors of the
+//! over-predicts growth rates; the backward errors of the
 //! expanded modes on the full operator say so.
 //!
 //! The modes come from the request's `modal` solver (normally `arpack` or `krylov`);

@@ -2,8 +2,7 @@
 //!
 //! Parametric model reduction by proper orthogonal decomposition (POD), registered as
 //! `"pod"` (Graebner, Mehrmann, Quraishi, Schroeder and von Wagner, "Numerical methods for
-//! parametric model reduction in the simulation of disk brake squeal", ZAMM 96(12), 2016;
-//! METHODS.md section 9):
+//! parametric model reduction in the simulation of disk brake squeal", ZAMM 96(12), 2016):
 //!
 //! 1. solve the FULL frictional QEP at a few snapshot friction coefficients
 //!    `mu_1 .. mu_k` (the request's `modal` solver, a sparse full-order backend such as

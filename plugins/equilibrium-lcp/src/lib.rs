@@ -3,7 +3,7 @@
 //! The direct sliding-equilibrium solver `lcp`: one Cholesky factorization of `K`,
 //! condensation on the contact pairs (`2 nc` solves), then the non-symmetric linear
 //! complementarity problem `0 <= Rn ⟂ q + (W + mu Wnt + c I) Rn >= 0` solved exactly by
-//! block principal pivoting (METHODS.md section 1). `c` is the contact law's compliance
+//! block principal pivoting. `c` is the contact law's compliance
 //! (0 for `lagrange`, `1/kn` for `penalty`).
 //!
 //! Parameters: `max_iterations` (pivoting steps, default 1000).

@@ -4,8 +4,8 @@
 //! `mu Rn` of the previous iterate are applied as known loads, an inner Signorini
 //! active-set loop gives the new normal reactions, and the two are repeated (with
 //! optional relaxation `omega`) until the reactions and the active set stop changing.
-//! With a fixed active set it converges iff `mu rho(W_AA^-1 Wnt_AA) < 1`
-//! (METHODS.md section 1); relaxation helps when that ratio is close to one.
+//! With a fixed active set it converges iff `mu rho(W_AA^-1 Wnt_AA) < 1`;
+//! relaxation helps when that ratio is close to one.
 //!
 //! Parameters: `relaxation` (omega in (0, 1], default 1), `tol` (relative change of
 //! `Rn`, default 1e-11), `max_iterations` (outer, default 500).

@@ -1,7 +1,7 @@
 //! First versions of the contact-side plugin traits: [`ContactLaw`],
 //! [`EquilibriumSolver`] and [`ReductionBasis`], with the data they exchange.
 //!
-//! Conventions (METHODS.md section 0): row `i` of `Pn` carries `+n_i` on the pin node and
+//! Conventions: row `i` of `Pn` carries `+n_i` on the pin node and
 //! `-n_i` on the disc node of pair `i` (a positive value opens the gap); `Pt` the same with
 //! the sliding direction `e_i`. `Rn >= 0` is compressive and the friction `mu Rn` drags
 //! the pin along `+e_i`. The static sliding equilibrium solves

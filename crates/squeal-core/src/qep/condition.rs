@@ -1,4 +1,4 @@
-//! Forward error estimates of QEP eigenvalues (METHODS.md section 8).
+//! Forward error estimates of QEP eigenvalues (`docs/error-estimate.md`).
 //!
 //! The backward error `eta` of a computed pair `(lambda, x)` says how far the pair is
 //! from an exact pair of a nearby problem. The error of the eigenvalue itself is, to

@@ -244,7 +244,7 @@ fn hoffmann_two_dof_matches_closed_form() {
         ..Default::default()
     };
 
-    // mu = 0.3: METHODS.md gives lambda = +-0.04762 + 1.04989 i.
+    // mu = 0.3: the closed form gives lambda = +-0.04762 + 1.04989 i.
     let qep = op.at(0.3).unwrap();
     let modes = solve_qep_band("test", &PanicKernel, &qep, &params).unwrap();
     assert!(

@@ -4,7 +4,7 @@ use crate::linalg::{dot, spmv};
 use crate::{c64, SparseRef};
 
 /// MAC between a real mode `phi` and a complex mode `psi` in the `M` inner product,
-/// Hermitian form (METHODS.md section 5):
+/// Hermitian form:
 /// `|phi^T M conj(psi)|^2 / ((phi^T M phi) (psi^H M psi))`, in [0, 1], independent of
 /// the phase of `psi`.
 pub fn mac_real_complex(m: SparseRef<'_>, phi: &[f64], psi: &[c64]) -> f64 {

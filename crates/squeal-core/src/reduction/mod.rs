@@ -1,4 +1,4 @@
-//! Shared machinery of the reduction bases (METHODS.md section 4), written once and used
+//! Shared machinery of the reduction bases, written once and used
 //! by every [`ReductionBasis`](crate::ReductionBasis):
 //!
 //! - `M_c`-orthonormalization with a rank cut ([`m_orthonormalize`],

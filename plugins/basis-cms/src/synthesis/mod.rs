@@ -3,8 +3,8 @@
 //! basis, built once per model and region and then reused for every contact set and mu.
 //!
 //! For the active pairs `A` the linearized problem is the descriptor system
-//! `(lambda^2 M + K) u = B_A^T r`, `Pn_A u = 0`, `B_A = Pn_A + mu Pt_A` (METHODS.md
-//! section 2, undamped). With the free-interface modes `Phi` of the unconstrained model
+//! `(lambda^2 M + K) u = B_A^T r`, `Pn_A u = 0`, `B_A = Pn_A + mu Pt_A`
+//! (undamped). With the free-interface modes `Phi` of the unconstrained model
 //! (no pair tied: `K Phi = M Phi Omega^2`, `Phi^T M Phi = I`) up to a cutoff, and the
 //! residual flexibility `G = K^-1 - Phi Omega^-2 Phi^T` taken at `lambda = 0`,
 //!

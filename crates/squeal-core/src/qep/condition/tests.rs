@@ -137,7 +137,7 @@ fn the_forward_error_of_a_perturbed_solve_stays_below_cond_times_eta() {
     );
 }
 
-/// The Hoffmann two-DOF model (METHODS.md section 6), flutter from mu_c = 0.2.
+/// The Hoffmann two-DOF model, flutter from mu_c = 0.2.
 fn hoffmann(mu: f64) -> Qep {
     let m = Mat::<f64>::identity(2, 2);
     let k = Mat::from_fn(2, 2, |i, j| [[1.0, 0.1 - mu], [0.1, 1.2]][i][j]);
