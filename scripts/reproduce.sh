@@ -2,7 +2,7 @@
 # Regenerates one result of the README: `bash scripts/reproduce.sh NAME`, from the
 # repository root, after `bash scripts/setup.sh`. Each writes into out/NAME (a run that is
 # interrupted continues with the same command: the long ones resume). Times are for the
-# 2-core machine the README's figures were measured on.
+# 2-core machine the figures of docs/results.md were measured on.
 #
 #   validate        the main job: Table 2, the rig, equilibria, Figure 5, bases vs full order
 #   calibrate-rig   the pin assembly fitted to the paper's datum, pin modes and couplings (~2 h)
