@@ -44,4 +44,4 @@ pub use modes::{
     add_condition, band_pairs, finish_modes, finish_modes_with, finish_operator_modes,
     finish_operator_modes_with_left, CONDITION_WHERE_NEEDED_MAX_DIM, REAL_ROOT_REL,
 };
-pub use residual::backward_error;
+pub use residual::{backward_error, residuals_and_derivatives};

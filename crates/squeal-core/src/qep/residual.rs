@@ -6,7 +6,7 @@ use crate::linalg::norm1;
 use crate::linalg::{norm2_c, spmv_complex, spmv_complex_add};
 use crate::operator::{FrictionalOperator, Qep};
 use crate::{c64, SparseMat, SparseRef};
-use faer::MatRef;
+use faer::{Mat, MatRef};
 
 /// The three norms entering the backward error (1-norms), and upper bounds of the
 /// 2-norms of `M` and `C` (`sqrt(||X||_1 ||X||_inf)`) for the smallest condition number
@@ -313,6 +313,30 @@ pub(super) fn in_two_halves<T: Send>(
     });
     first.extend(second);
     first
+}
+
+/// `Q(lambda_j) x_j` and `Q'(lambda_j) x_j = (2 lambda_j M + C) x_j` for the columns `x_j`
+/// of `x`, on the parts of `op` at `mu` without assembling them (one pass over each part
+/// for all columns).
+pub fn residuals_and_derivatives(
+    op: &FrictionalOperator,
+    mu: f64,
+    lambda: &[c64],
+    x: MatRef<'_, c64>,
+) -> (Mat<c64>, Mat<c64>) {
+    let terms = QepTerms::of_operator(op, mu);
+    let (n, w) = (x.nrows(), x.ncols());
+    let xi = interleave(x, 0, w);
+    let mx = terms_times(n, &terms.m, &xi, w);
+    let kx = terms_times(n, &terms.k, &xi, w);
+    let cx = (!terms.c.is_empty()).then(|| terms_times(n, &terms.c, &xi, w));
+    let c_at = |i, j| cx.as_ref().map_or(c64::new(0.0, 0.0), |cx| at(cx, w, i, j));
+    let r = Mat::from_fn(n, w, |i, j| {
+        let l = lambda[j];
+        at(&kx, w, i, j) + l * (c_at(i, j) + l * at(&mx, w, i, j))
+    });
+    let d = Mat::from_fn(n, w, |i, j| c_at(i, j) + lambda[j] * 2.0 * at(&mx, w, i, j));
+    (r, d)
 }
 
 /// Backward error of `(lambda, u)` on `qep` (see module docs).

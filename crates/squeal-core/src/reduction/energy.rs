@@ -29,9 +29,11 @@
 //! that bound and above the round-off that no bound resolves): two solves each.
 
 use super::real_mode_pair;
-use crate::linalg::{spmv, spmv_complex, Cholesky};
+use crate::linalg::{spmv, Cholesky};
 use crate::operator::{ComplexModes, FrictionalOperator, RealModePair, BACKWARD_ERROR_FLOOR};
+use crate::qep::residuals_and_derivatives;
 use crate::{c64, Error, Result};
+use faer::Mat;
 use std::sync::Arc;
 
 /// The symmetric positive definite weight of [`energy_bounds`].
@@ -62,41 +64,6 @@ pub fn energy_bounds_on(
         (None, RealModePair::Lazy(_)) => energy_bounds(op, mu, modes, EnergyWeight::Pair),
         (None, RealModePair::Own) => Ok(0),
     }
-}
-
-/// `Q(lambda) x` and `Q'(lambda) x` on the parts of `op` at `mu`.
-fn residual_and_derivative(
-    op: &FrictionalOperator,
-    mu: f64,
-    lambda: c64,
-    x: &[c64],
-) -> (Vec<c64>, Vec<c64>) {
-    let n = x.len();
-    let mut t = vec![c64::new(0.0, 0.0); n];
-    let mut acc = |a: &crate::SparseMat, s: f64, out: &mut Vec<c64>| {
-        spmv_complex(a.as_ref(), x, &mut t);
-        out.iter_mut().zip(&t).for_each(|(o, v)| *o += *v * s);
-    };
-    let (mut mx, mut cx, mut kx) = (
-        vec![c64::new(0.0, 0.0); n],
-        vec![c64::new(0.0, 0.0); n],
-        vec![c64::new(0.0, 0.0); n],
-    );
-    acc(&op.mc, 1.0, &mut mx);
-    acc(&op.fm, -mu, &mut mx);
-    if let Some(c) = &op.cc {
-        acc(c, 1.0, &mut cx);
-    }
-    if let Some(f) = &op.fc {
-        acc(f, -mu, &mut cx);
-    }
-    acc(&op.kc, 1.0, &mut kx);
-    acc(&op.fk, -mu, &mut kx);
-    let r = (0..n)
-        .map(|i| kx[i] + lambda * (cx[i] + lambda * mx[i]))
-        .collect();
-    let d = (0..n).map(|i| cx[i] + lambda * 2.0 * mx[i]).collect();
-    (r, d)
 }
 
 /// `sqrt(z^H A z)` of a complex vector with a real symmetric `A`.
@@ -194,32 +161,33 @@ pub fn energy_bounds(
         _ => None,
     };
     let pair = real_mode_pair(op)?;
-    let mut done = 0;
-    for &j in &open {
-        let l = modes.lambda[j];
-        let x: Vec<c64> = (0..n).map(|i| modes.vectors[(i, j)]).collect();
+    let x = Mat::from_fn(n, open.len(), |i, k| modes.vectors[(i, open[k])]);
+    let lambda: Vec<c64> = open.iter().map(|&j| modes.lambda[j]).collect();
+    let (r, dx) = residuals_and_derivatives(op, mu, &lambda, x.as_ref());
+    for (k, &j) in open.iter().enumerate() {
+        let l = lambda[k];
         let yj: Vec<c64> = (0..n).map(|i| y[(i, j)]).collect();
-        let (r, dx) = residual_and_derivative(op, mu, l, &x);
-        let yqx: c64 = yj.iter().zip(&dx).map(|(a, b)| a.conj() * b).sum();
+        let rk: Vec<c64> = (0..n).map(|i| r[(i, k)]).collect();
+        let yqx: c64 = (0..n).map(|i| yj[i].conj() * dx[(i, k)]).sum();
         let (ny, nr) = match (weight, &mult) {
             (EnergyWeight::FreeModel(f), Some(m)) => {
                 let map = op.t.as_deref().expect("checked above");
                 (
                     a_norm(op.kc.as_ref(), &yj),
-                    inverse_norm(f, &lift(&r, map, m)),
+                    inverse_norm(f, &lift(&rk, map, m)),
                 )
             }
             _ => (
                 a_norm(pair.k, &yj),
-                inverse_norm(pair_factor.as_deref().expect("built above"), &r),
+                inverse_norm(pair_factor.as_deref().expect("built above"), &rk),
             ),
         };
         let bound = ny * nr / (l.norm() * yqx.norm());
         if bound.is_finite() && bound < modes.error_bound[j] {
             modes.error_bound[j] = bound;
         }
-        done += 1;
     }
+    let done = open.len();
     modes.info.notes.push(format!(
         "error_bound in the energy norm of {} for the {done} of {} modes whose class the \
          Euclidean bound left open, {:.3} s",
