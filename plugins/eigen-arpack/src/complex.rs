@@ -8,6 +8,7 @@ use squeal_core::c64;
 use squeal_core::faer::Mat;
 use squeal_core::qep::{ComplexKernel, ComplexKernelOutput};
 use squeal_core::spectral::LinOp;
+use squeal_core::spectral::RealOp;
 use squeal_core::Result;
 
 // `c64` (`num_complex::Complex<f64>`) and ARPACK's `double _Complex` must share their
@@ -60,6 +61,18 @@ impl ComplexKernel for ArpackComplexKernel {
         max_restarts: usize,
     ) -> Result<ComplexKernelOutput> {
         Ok(run(op, nev, tol, max_restarts)?)
+    }
+
+    /// ARPACK's real non-symmetric driver (`dnaupd`/`dneupd`, mode 1) on the real view:
+    /// one real column per application (see [`ComplexKernel::largest_real`]).
+    fn largest_real(
+        &self,
+        op: &dyn RealOp,
+        nev: usize,
+        tol: f64,
+        max_restarts: usize,
+    ) -> Result<ComplexKernelOutput> {
+        Ok(crate::real::run(op.real(), nev, tol, max_restarts)?)
     }
 }
 
@@ -130,7 +143,11 @@ impl Session {
     fn new(n: usize, nev: usize, tol: f64, max_restarts: usize) -> Result<Self, ArpackError> {
         let ncv = ArpackComplexKernel::ncv(n, nev);
         if nev == 0 || nev + 2 > ncv {
-            return Err(ArpackError::TooSmall { nev, n });
+            return Err(ArpackError::TooSmall {
+                routine: Routine::Znaupd,
+                nev,
+                n,
+            });
         }
         let lworkl = 3 * ncv * ncv + 5 * ncv;
         let n_c = to_int("n", n)?;

@@ -9,6 +9,7 @@ use squeal_core::faer::sparse::Triplet;
 use squeal_core::faer::Mat;
 use squeal_core::qep::dense_qep;
 use squeal_core::qep::ComplexKernel;
+use squeal_core::spectral::RealOp;
 use squeal_core::spectral::{LinOp, SpectralTransform};
 use squeal_core::{EigenParams, EigenSolver, Qep};
 use squeal_core::{Error, SparseMat};
@@ -228,11 +229,10 @@ fn largest_modulus_eigenpairs_of_a_known_nonnormal_matrix() {
     }
 }
 
-#[test]
-fn conjugate_pair_of_a_real_matrix_comes_back_conjugate() {
-    // A real matrix (real S, d closed under conjugation) seen as a complex operator: the
-    // conjugate pair 9 +- 3i and both vectors (complex conjugates of each other).
-    let n = 120;
+/// A real `n x n` matrix `S D S^-1` with the conjugate pairs `9 +- 3i`, `-6 +- 4i`,
+/// `+-7i`, the values 10 (twice), -9, 6.5 and `n - 10` real values of modulus below 3.1
+/// (`S` real but for conjugate columns of the pairs).
+fn real_known_spectrum(n: usize) -> Mat<f64> {
     let mut rng = Rng(11);
     let mut d: Vec<c64> = TOP.iter().map(|&(re, im)| c(re, im)).collect();
     // Make the list closed under conjugation: replace the lone complex values.
@@ -268,7 +268,16 @@ fn conjugate_pair_of_a_real_matrix_comes_back_conjugate() {
         .map(|(i, j)| a[(i, j)].im.abs())
         .fold(0.0, f64::max);
     assert!(imag < 1e-12, "test matrix not real: {imag:e}");
-    let op = DenseOp::new(Mat::from_fn(n, n, |i, j| c(a[(i, j)].re, 0.0)));
+    Mat::from_fn(n, n, |i, j| a[(i, j)].re)
+}
+
+#[test]
+fn conjugate_pair_of_a_real_matrix_comes_back_conjugate() {
+    // A real matrix (real S, d closed under conjugation) seen as a complex operator: the
+    // conjugate pair 9 +- 3i and both vectors (complex conjugates of each other).
+    let n = 120;
+    let a = real_known_spectrum(n);
+    let op = DenseOp::new(Mat::from_fn(n, n, |i, j| c(a[(i, j)], 0.0)));
     let out = ArpackComplexKernel.largest(&op, 10, 1e-12, 300).unwrap();
     assert!(out.all_converged);
     let find = |w: c64| {
@@ -288,6 +297,97 @@ fn conjugate_pair_of_a_real_matrix_comes_back_conjugate() {
         );
         for (t, v) in [(p, &vp), (q, &vq)] {
             assert!(residual(&op, t, v) <= 1e-10 * t.norm());
+        }
+    }
+}
+
+/// A real dense operator with a view on real and on complex vectors; counts the
+/// applications of each view.
+struct RealDenseOp {
+    a: Mat<f64>,
+    real_applications: AtomicUsize,
+    complex_applications: AtomicUsize,
+}
+
+impl LinOp<f64> for RealDenseOp {
+    fn dim(&self) -> usize {
+        self.a.nrows()
+    }
+    fn apply(&self, x: &[f64], y: &mut [f64]) {
+        for (i, yi) in y.iter_mut().enumerate() {
+            *yi = (0..x.len()).map(|j| self.a[(i, j)] * x[j]).sum();
+        }
+        self.real_applications.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+impl LinOp<c64> for RealDenseOp {
+    fn dim(&self) -> usize {
+        self.a.nrows()
+    }
+    fn apply(&self, x: &[c64], y: &mut [c64]) {
+        for (i, yi) in y.iter_mut().enumerate() {
+            *yi = (0..x.len()).map(|j| x[j] * self.a[(i, j)]).sum();
+        }
+        self.complex_applications.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+impl RealOp for RealDenseOp {
+    fn real(&self) -> &dyn LinOp<f64> {
+        self
+    }
+    fn complex(&self) -> &dyn LinOp<c64> {
+        self
+    }
+}
+
+#[test]
+fn real_driver_finds_the_complex_drivers_values_on_real_vectors() {
+    // dnaupd on the real view against znaupd on the complex view of the same real
+    // matrix: the same ten values (both members of each conjugate pair, vectors
+    // conjugate), small residuals, and only real applications.
+    let n = 120;
+    let op = RealDenseOp {
+        a: real_known_spectrum(n),
+        real_applications: AtomicUsize::new(0),
+        complex_applications: AtomicUsize::new(0),
+    };
+    let real = ArpackComplexKernel
+        .largest_real(&op, 10, 1e-12, 300)
+        .unwrap();
+    assert!(real.all_converged);
+    assert!(op.real_applications.load(Ordering::Relaxed) > 0);
+    assert_eq!(op.complex_applications.load(Ordering::Relaxed), 0);
+    let complex = ArpackComplexKernel.largest(&op, 10, 1e-12, 300).unwrap();
+    assert!(op.complex_applications.load(Ordering::Relaxed) > 0);
+    let sorted = |t: &[c64]| {
+        let mut t = t.to_vec();
+        t.sort_by(|a, b| a.re.total_cmp(&b.re).then(a.im.total_cmp(&b.im)));
+        t
+    };
+    let (tr, tc) = (sorted(&real.theta), sorted(&complex.theta));
+    // dnaupd may return an eleventh value (the other half of a pair cut by nev)
+    assert!(tr.len() >= 10 && tr.len() <= 11, "{tr:?}");
+    for w in &tc {
+        assert!(
+            tr.iter().any(|t| (t - w).norm() <= 1e-10 * w.norm()),
+            "{w} of znaupd not among dnaupd's {tr:?}"
+        );
+    }
+    let dense = DenseOp::new(Mat::from_fn(n, n, |i, j| c(op.a[(i, j)], 0.0)));
+    for (k, &t) in real.theta.iter().enumerate() {
+        let v = column(&real.vectors, k);
+        assert!(
+            residual(&dense, t, &v) <= 1e-10 * t.norm(),
+            "residual of {t}"
+        );
+        if t.im != 0.0 {
+            let partner = (0..real.theta.len())
+                .find(|&q| real.theta[q] == t.conj())
+                .unwrap_or_else(|| panic!("{t} without its conjugate"));
+            let w = column(&real.vectors, partner);
+            assert!(v.iter().zip(&w).all(|(a, b)| *a == b.conj()));
         }
     }
 }
@@ -314,7 +414,14 @@ fn too_small_operators_and_bad_requests_are_clear_errors() {
                 .largest(&op, nev, 1e-12, 300)
                 .unwrap_err(),
         );
-        assert_eq!(e, ArpackError::TooSmall { nev, n: 200 });
+        assert_eq!(
+            e,
+            ArpackError::TooSmall {
+                routine: Routine::Znaupd,
+                nev,
+                n: 200
+            }
+        );
         let msg = e.to_string();
         for needle in [
             "znaupd",
@@ -350,7 +457,14 @@ fn too_small_operators_and_bad_requests_are_clear_errors() {
                 .largest(&tiny, nev, 1e-12, 300)
                 .unwrap_err(),
         );
-        assert_eq!(e, ArpackError::TooSmall { nev, n });
+        assert_eq!(
+            e,
+            ArpackError::TooSmall {
+                routine: Routine::Znaupd,
+                nev,
+                n
+            }
+        );
     }
     // max_restarts = 0 reaches ARPACK, which rejects it (info = -4 of znaupd).
     let e = arpack_error(ArpackComplexKernel.largest(&op, 4, 1e-12, 0).unwrap_err());
@@ -496,10 +610,17 @@ fn complex_info_codes_name_the_routine_and_the_meaning() {
     assert!(s.contains("Lanczos factorization"), "{s}");
 }
 
-/// A small damped QEP with a non-symmetric ("friction") stiffness coupling: the `arpack`
-/// solver (band driver + complex kernel) against the dense companion solver.
+/// A small QEP with a non-symmetric ("friction") stiffness coupling, damped (companion
+/// form, complex driver) and undamped (squared form, real driver): the `arpack` solver
+/// (band driver + kernel) against the dense companion solver.
 #[test]
 fn solve_qep_matches_the_dense_companion_solver() {
+    for damped in [true, false] {
+        solve_qep_matches_dense(damped);
+    }
+}
+
+fn solve_qep_matches_dense(damped: bool) {
     let n = 60;
     let (mut tk, mut tm, mut tc) = (Vec::new(), Vec::new(), Vec::new());
     let kk = 1.0e4;
@@ -519,7 +640,7 @@ fn solve_qep_matches_the_dense_companion_solver() {
     }
     let qep = Qep {
         m: SparseMat::try_new_from_triplets(n, n, &tm).unwrap(),
-        c: Some(SparseMat::try_new_from_triplets(n, n, &tc).unwrap()),
+        c: damped.then(|| SparseMat::try_new_from_triplets(n, n, &tc).unwrap()),
         k: SparseMat::try_new_from_triplets(n, n, &tk).unwrap(),
     };
     let (all, _) = dense_qep(&qep).unwrap();

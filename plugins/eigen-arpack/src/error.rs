@@ -14,6 +14,10 @@ pub enum Routine {
     Znaupd,
     /// `zneupd`, the Ritz value and vector extraction after `znaupd`.
     Zneupd,
+    /// `dnaupd`, the implicitly restarted Arnoldi iteration (real non-symmetric).
+    Dnaupd,
+    /// `dneupd`, the Ritz value and vector extraction after `dnaupd`.
+    Dneupd,
 }
 
 impl Routine {
@@ -21,7 +25,7 @@ impl Routine {
     pub fn krylov(self) -> &'static str {
         match self {
             Routine::Dsaupd | Routine::Dseupd => "Lanczos",
-            Routine::Znaupd | Routine::Zneupd => "Arnoldi",
+            Routine::Znaupd | Routine::Zneupd | Routine::Dnaupd | Routine::Dneupd => "Arnoldi",
         }
     }
 
@@ -31,6 +35,7 @@ impl Routine {
         match self {
             Routine::Dsaupd | Routine::Dseupd => Routine::Dsaupd,
             Routine::Znaupd | Routine::Zneupd => Routine::Znaupd,
+            Routine::Dnaupd | Routine::Dneupd => Routine::Dnaupd,
         }
     }
 }
@@ -42,6 +47,8 @@ impl fmt::Display for Routine {
             Routine::Dseupd => "dseupd",
             Routine::Znaupd => "znaupd",
             Routine::Zneupd => "zneupd",
+            Routine::Dnaupd => "dnaupd",
+            Routine::Dneupd => "dneupd",
         })
     }
 }
@@ -104,7 +111,7 @@ pub enum ArpackError {
     /// `info = -8` of `znaupd`/`zneupd`: LAPACK (`zlahqr`/`ztrevc`) failed on the
     /// projected upper Hessenberg eigenproblem.
     #[error(
-        "{routine}: LAPACK failed on the upper Hessenberg eigenproblem (zlahqr/ztrevc, info = -8)"
+        "{routine}: LAPACK failed on the upper Hessenberg eigenproblem (zlahqr/ztrevc or dlahqr/dtrevc, info = -8)"
     )]
     Hessenberg {
         /// Reporting routine.
@@ -112,14 +119,14 @@ pub enum ArpackError {
     },
     /// `info = -9` of `zneupd`: LAPACK `ztrevc` failed to compute the eigenvectors of the
     /// Schur form.
-    #[error("{routine}: LAPACK ztrevc failed to compute the Ritz vectors (info = -9)")]
+    #[error("{routine}: LAPACK ztrevc/dtrevc failed to compute the Ritz vectors (info = -9)")]
     Eigenvectors {
         /// Reporting routine.
         routine: Routine,
     },
     /// `info = 1` of `zneupd`: LAPACK `ztrsen` could not reorder the Schur form to bring
     /// the converged Ritz values to the front.
-    #[error("{routine}: LAPACK ztrsen could not reorder the Schur form (info = 1)")]
+    #[error("{routine}: LAPACK ztrsen/dtrsen could not reorder the Schur form (info = 1)")]
     Reorder {
         /// Reporting routine.
         routine: Routine,
@@ -195,15 +202,18 @@ pub enum ArpackError {
         /// Operator dimension.
         n: usize,
     },
-    /// The operator is too small for `znaupd`/`zneupd` with this `nev` (or `nev = 0`):
+    /// The operator is too small for `znaupd`/`zneupd` or `dnaupd`/`dneupd` with this
+    /// `nev` (or `nev = 0`):
     /// ARPACK needs `nev + 2 <= ncv <= n`, i.e. `1 <= nev <= n - 2`. Small problems
     /// belong to a dense solver.
     #[error(
-        "znaupd: cannot compute {nev} eigenpairs of a complex operator of dimension {n}: \
+        "{routine}: cannot compute {nev} eigenpairs of an operator of dimension {n}: \
          ARPACK needs 1 <= nev <= n - 2 (nev + 2 <= ncv <= n); the operator is too small \
          for ARPACK, use a dense eigensolver"
     )]
     TooSmall {
+        /// The iteration routine.
+        routine: Routine,
         /// Requested pairs.
         nev: usize,
         /// Operator dimension.
@@ -226,7 +236,7 @@ impl ArpackError {
     /// `nev` and `ncv` are the run's sizes, `iparam5` the value of `iparam[4]` on return
     /// (converged count, or factorization size for `-9999`).
     pub fn from_info(routine: Routine, info: i32, nev: usize, ncv: usize, iparam5: i32) -> Self {
-        use Routine::{Dsaupd, Dseupd, Znaupd, Zneupd};
+        use Routine::{Dnaupd, Dneupd, Dsaupd, Dseupd, Znaupd, Zneupd};
         let size = usize::try_from(iparam5).unwrap_or(0);
         let invalid = |meaning: &'static str| ArpackError::InvalidArgument {
             routine,
@@ -235,28 +245,28 @@ impl ArpackError {
         };
         match (routine, info) {
             // Codes common to all four routines.
-            (Dsaupd | Dseupd | Znaupd, 1) => ArpackError::MaxIterations {
+            (Dsaupd | Dseupd | Znaupd | Dnaupd, 1) => ArpackError::MaxIterations {
                 routine,
                 converged: size,
                 requested: nev,
             },
-            (Dsaupd | Znaupd, 2 | 3) => ArpackError::NoShifts {
+            (Dsaupd | Znaupd | Dnaupd, 2 | 3) => ArpackError::NoShifts {
                 routine,
                 code: info,
                 nev,
                 ncv,
             },
             (_, -9999) => ArpackError::NoFactorization { routine, size },
-            (Dseupd | Zneupd, -14) => ArpackError::NoneConverged { routine },
+            (Dseupd | Zneupd | Dneupd, -14) => ArpackError::NoneConverged { routine },
             (_, -1) => invalid("N must be positive"),
             (_, -2) => invalid("NEV must be positive"),
-            (Dsaupd | Znaupd, -4) => {
+            (Dsaupd | Znaupd | Dnaupd, -4) => {
                 invalid("the maximum number of update iterations (iparam[2]) must be positive")
             }
             (_, -6) => invalid("BMAT must be one of I or G"),
-            (Dsaupd | Dseupd | Znaupd, -9) => invalid("the starting vector is zero"),
+            (Dsaupd | Dseupd | Znaupd | Dnaupd, -9) => invalid("the starting vector is zero"),
             (_, -11) => invalid("IPARAM(7) = 1 and BMAT = G are incompatible"),
-            (Dsaupd | Znaupd, -12) => invalid("IPARAM(1) (shift strategy) must be 0 or 1"),
+            (Dsaupd | Znaupd | Dnaupd, -12) => invalid("IPARAM(1) (shift strategy) must be 0 or 1"),
 
             // Symmetric routines.
             (Dsaupd | Dseupd, -8) => ArpackError::Tridiagonal { routine },
@@ -290,6 +300,23 @@ impl ArpackError {
             (Znaupd | Zneupd, -10) => invalid("IPARAM(7) (mode) must be 1, 2 or 3"),
             (Zneupd, -12) => invalid("HOWMNY = S is not implemented"),
             (Zneupd, -13) => invalid("HOWMNY must be A or P when RVEC is true"),
+
+            // Real non-symmetric routines.
+            (Dneupd, 1) => ArpackError::Reorder { routine },
+            (Dnaupd | Dneupd, -8) => ArpackError::Hessenberg { routine },
+            (Dneupd, -9) => ArpackError::Eigenvectors { routine },
+            (Dneupd, -15) => ArpackError::ConvergedCountMismatch {
+                routine,
+                code: info,
+            },
+            (Dnaupd | Dneupd, -3) => invalid("NCV must satisfy NEV + 2 <= NCV <= N"),
+            (Dnaupd | Dneupd, -5) => invalid("WHICH must be one of LM, SM, LR, SR, LI or SI"),
+            (Dnaupd | Dneupd, -7) => {
+                invalid("WORKL is too short: LWORKL must be at least 3 NCV^2 + 6 NCV")
+            }
+            (Dnaupd | Dneupd, -10) => invalid("IPARAM(7) (mode) must be 1, 2, 3 or 4"),
+            (Dneupd, -12) => invalid("HOWMNY = S is not implemented"),
+            (Dneupd, -13) => invalid("HOWMNY must be A or P when RVEC is true"),
 
             _ => ArpackError::Unknown {
                 routine,

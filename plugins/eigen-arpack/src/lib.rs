@@ -3,8 +3,9 @@
 //! The `arpack` eigen solver: ARPACK's implicitly restarted Lanczos method
 //! (`dsaupd`/`dseupd`, ARPACK-NG through [`arpack_ffi`]) in shift-invert mode on the
 //! symmetric generalized problem of the normal modes, and its implicitly restarted
-//! Arnoldi method (`znaupd`/`zneupd`) for the complex modes of the frictional quadratic
-//! eigenproblem (see the last section). Normal modes:
+//! Arnoldi methods, complex (`znaupd`/`zneupd`) and real (`dnaupd`/`dneupd`), for the
+//! complex modes of the frictional quadratic eigenproblem (see the last section).
+//! Normal modes:
 //!
 //! ```text
 //! K x = lambda M x,   lambda = omega^2,   K = K^T >= 0,   M = M^T > 0.
@@ -52,6 +53,15 @@
 //! returns the operator eigenvalues `theta`; the driver maps them back,
 //! `lambda = sigma + 1 / theta`.
 //!
+//! An undamped operator (`C = 0`) is solved through the squared transformation
+//! `OP = (K~ - s M~)^-1 M~` at a real shift ([`SquaredShift`](squeal_core::spectral::SquaredShift)),
+//! a real operator: [`ComplexKernel::largest_real`](squeal_core::qep::ComplexKernel::largest_real)
+//! runs ARPACK's real driver `dnaupd`/`dneupd` (mode 1, `which = "LM"`) on it, one real
+//! column per application and real orthogonalization, where the complex driver would
+//! apply it to two real columns in complex arithmetic. Its complex Ritz values come in
+//! conjugate pairs, whose vectors `dneupd` stores as a real and an imaginary column;
+//! both members are returned.
+//!
 //! Reference: R. B. Lehoucq, D. C. Sorensen, C. Yang, *ARPACK Users' Guide: Solution of
 //! Large-Scale Eigenvalue Problems with Implicitly Restarted Arnoldi Methods*, SIAM,
 //! Philadelphia, 1998 (section 3.2.3 and appendix for `dsaupd` mode 3; `info` codes
@@ -60,6 +70,7 @@
 mod complex;
 mod error;
 mod kernel;
+mod real;
 
 pub use complex::ArpackComplexKernel;
 pub use error::{ArpackError, Routine};
@@ -88,7 +99,8 @@ pub fn register(reg: &mut squeal_core::Registry) {
     reg.eigen.register(
         NAME,
         "ARPACK shift-invert Lanczos (dsaupd mode 3) on a sparse Cholesky of K - sigma M; \
-         complex modes by znaupd (mode 1) on the companion shift-invert operator (sparse LU)",
+         complex modes by znaupd (mode 1) on the companion shift-invert operator (sparse LU), \
+         or by dnaupd on the real squared transformation when C = 0",
         |p| Ok(Box::new(solver(p)?)),
     );
 }

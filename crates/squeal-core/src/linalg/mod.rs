@@ -415,6 +415,9 @@ pub fn expand(v: MatRef<'_, f64>, q: MatRef<'_, crate::c64>) -> Mat<crate::c64> 
 }
 
 #[cfg(test)]
+mod par_products_tests;
+
+#[cfg(test)]
 mod tests {
     use super::*;
 

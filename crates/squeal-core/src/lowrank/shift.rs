@@ -29,6 +29,8 @@ pub struct SymmetricShift {
     pub(super) par: Par,
     /// Relative residual of the probe solve with `S(s)`.
     s_residual: f64,
+    /// Seconds of the numeric factorization and of `Z = S^-1 U`.
+    times: (f64, f64),
 }
 
 impl SymmetricShift {
@@ -44,6 +46,7 @@ impl SymmetricShift {
             return Err(Error::param("sigma_s", format!("must be finite, got {s}")));
         }
         let what = || format!("K_c - s M_c (s = {s:.6e} (rad/s)^2, n = {n}, LBL^T)");
+        let start = std::time::Instant::now();
         let vals = pencil.assemble(op, s)?;
         let a = faer::sparse::SparseColMatRef::new(pencil.pattern.as_ref(), &vals);
         let par = faer::get_global_parallelism();
@@ -83,6 +86,7 @@ impl SymmetricShift {
             z: Mat::zeros(0, 0),
             par,
             s_residual: 0.0,
+            times: (0.0, 0.0),
         };
         // probe: S x = b
         let b: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * (i as f64).sin()).collect();
@@ -110,6 +114,8 @@ impl SymmetricShift {
             0.0
         };
         // Z = S^-1 U, by blocks of columns
+        let t_numeric = start.elapsed().as_secs_f64();
+        let start = std::time::Instant::now();
         let na = friction.rank();
         let ur = friction.u.as_ref();
         let mut z = Mat::<f64>::zeros(n, na);
@@ -126,7 +132,14 @@ impl SymmetricShift {
             c0 += k;
         }
         this.z = z;
+        this.times = (t_numeric, start.elapsed().as_secs_f64());
         Ok(this)
+    }
+
+    /// Seconds of the numeric factorization of `S(s)` (with its probe solve) and of the
+    /// `nA` solves `Z = S^-1 U`.
+    pub fn times(&self) -> (f64, f64) {
+        self.times
     }
 
     /// The shift `s`.
@@ -148,6 +161,17 @@ impl SymmetricShift {
     /// solve.
     pub fn s_residual(&self) -> f64 {
         self.s_residual
+    }
+
+    /// `B <- S(s)^-1 B` in one sweep of the factor for all columns, with `par` inside
+    /// the dense kernels.
+    pub fn solve_block_in_place(&self, b: MatMut<'_, f64>, par: Par) {
+        let n = self.dim();
+        let chol = &self.pencil.chol;
+        let perm = PermRef::new_checked(&self.perm_fwd, &self.perm_inv, n);
+        let lblt = IntranodeLbltRef::new(chol, &self.l_values, &self.subdiag, perm);
+        let mut mem = MemBuffer::new(chol.solve_in_place_scratch::<f64>(b.ncols(), par));
+        lblt.solve_in_place_with_conj(Conj::No, b, par, MemStack::new(&mut mem));
     }
 
     /// `B <- S(s)^-1 B` (any number of columns).

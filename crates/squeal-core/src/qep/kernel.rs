@@ -1,7 +1,7 @@
 //! The trait of the full-order complex backends: a Krylov iteration for the eigenvalues
 //! of largest modulus of a complex operator ([`ComplexKernel`]).
 
-use crate::spectral::LinOp;
+use crate::spectral::{LinOp, RealOp};
 use crate::{c64, Result};
 use faer::Mat;
 
@@ -29,4 +29,19 @@ pub trait ComplexKernel: Send + Sync {
         tol: f64,
         max_restarts: usize,
     ) -> Result<ComplexKernelOutput>;
+
+    /// The same for a real operator ([`RealOp`]), whose eigenvalues are real or come in
+    /// conjugate pairs (both members returned). A backend with a real iteration uses
+    /// [`RealOp::real`]: one real column per application and real orthogonalization,
+    /// against two columns and complex arithmetic on the complex view. The default runs
+    /// [`largest`](Self::largest) on [`RealOp::complex`].
+    fn largest_real(
+        &self,
+        op: &dyn RealOp,
+        nev: usize,
+        tol: f64,
+        max_restarts: usize,
+    ) -> Result<ComplexKernelOutput> {
+        self.largest(op.complex(), nev, tol, max_restarts)
+    }
 }

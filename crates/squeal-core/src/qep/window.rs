@@ -10,20 +10,45 @@ use crate::operator::{Qep, SolveInfo, StopReason};
 use crate::spectral::{QepShiftInvert, QepSymbolic, SpectralTransform, SquaredShift};
 use crate::{c64, Error, Result};
 use std::sync::Arc;
-use std::time::Instant;
 
-/// The spectral transformation of one window of the band driver (companion or squared)
-/// and whether it is the squared one (its points are `s = -lambda^2`).
-struct WindowOp<'a> {
-    op: Box<dyn SpectralTransform<c64> + 'a>,
-    squared: bool,
+/// The spectral transformation of one window of the band driver: the companion form
+/// (complex) or the squared one (real; its points are `s = -lambda^2`).
+enum WindowOp<'a> {
+    Companion(QepShiftInvert<'a>),
+    Squared(SquaredShift<'a>),
 }
 
 impl WindowOp<'_> {
+    fn transform(&self) -> &dyn SpectralTransform<c64> {
+        match self {
+            WindowOp::Companion(op) => op,
+            WindowOp::Squared(op) => op,
+        }
+    }
+
+    fn squared(&self) -> bool {
+        matches!(self, WindowOp::Squared(_))
+    }
+
+    /// The kernel's `nev` eigenvalues of largest modulus: the real iteration of the
+    /// kernel on the squared transformation, the complex one on the companion form.
+    fn largest(
+        &self,
+        kernel: &dyn ComplexKernel,
+        nev: usize,
+        tol: f64,
+        max_restarts: usize,
+    ) -> Result<super::ComplexKernelOutput> {
+        match self {
+            WindowOp::Companion(op) => kernel.largest(op, nev, tol, max_restarts),
+            WindowOp::Squared(op) => kernel.largest_real(op, nev, tol, max_restarts),
+        }
+    }
+
     /// (point in the plane of the window, lambda).
     fn map(&self, theta: c64) -> (c64, c64) {
-        let point = self.op.pencil_eigenvalue(theta);
-        if self.squared {
+        let point = self.transform().pencil_eigenvalue(theta);
+        if self.squared() {
             (point, SquaredShift::lambda_of_s(point))
         } else {
             (point, point)
@@ -68,30 +93,28 @@ impl<'a> BandRun<'a> {
             if first {
                 self.info.notes.push(
                     "C = 0: real shift-invert of K - s M, s = -lambda^2 (squared \
-                     transformation), sparse LU of K~ - s M~"
+                     transformation, real Krylov iteration where the kernel has one), \
+                     sparse LU of K~ - s M~"
                         .into(),
                 );
             }
-            return Ok(WindowOp {
-                op: Box::new(SquaredShift::lu(qep, sigma)?),
-                squared: true,
-            });
+            return Ok(WindowOp::Squared(SquaredShift::lu(qep, sigma)?));
         };
-        let t = Instant::now();
         let shift = SymmetricShift::new(ctx.op, ctx.pencil.clone(), &ctx.friction, sigma)?;
-        let t_factor = t.elapsed().as_secs_f64();
+        let (t_numeric, t_z) = shift.times();
         let woodbury = Woodbury::new(qep, Arc::new(shift), ctx.mu)?;
         if first {
             self.info.notes.push(format!(
                 "C = 0: real shift-invert of K - s M, s = -lambda^2 (squared \
-                 transformation), low-rank path: symmetric LBL^T of K_c - s M_c \
-                 (nnz(L) = {} stored entries, symbolic {:.2} s, numeric + Z {:.2} s) + \
-                 Woodbury correction of rank nA = {} (U W^T error {:.1e}, asymmetry {:.1e}, \
+                 transformation, real Krylov iteration where the kernel has one), low-rank path: symmetric LBL^T of K_c - s M_c \
+                 (nnz(L) = {} stored entries, symbolic {:.2} s, numeric {:.2} s) + \
+                 Woodbury correction of rank nA = {} (Z = S^-1 U {:.2} s, U W^T error {:.1e}, asymmetry {:.1e}, \
                  S residual {:.1e}, A residual {:.1e}{})",
                 ctx.pencil.factor_entries(),
                 ctx.t_symbolic,
-                t_factor,
+                t_numeric,
                 ctx.friction.rank(),
+                t_z,
                 ctx.friction.identity_error,
                 ctx.pencil.asymmetry(),
                 woodbury.shift().s_residual(),
@@ -103,10 +126,7 @@ impl<'a> BandRun<'a> {
                 }
             ));
         }
-        Ok(WindowOp {
-            op: Box::new(SquaredShift::woodbury(qep, woodbury)?),
-            squared: true,
-        })
+        Ok(WindowOp::Squared(SquaredShift::woodbury(qep, woodbury)?))
     }
 
     /// Covers `[lo, hi]` Hz with one shift, or splits it.
@@ -129,19 +149,13 @@ impl<'a> BandRun<'a> {
             let radius = self.options.radius_factor * half + self.options.margin_rel * two_pi * hi;
             let qep: &'a Qep = self.qep;
             let op = QepShiftInvert::with_symbolic(qep, sigma, self.symbolic()?)?;
-            let op = WindowOp {
-                op: Box::new(op),
-                squared: false,
-            };
-            (sigma, radius, op)
+            (sigma, radius, WindowOp::Companion(op))
         };
-        let dim = op.op.dim();
+        let dim = op.transform().dim();
         self.info.factorizations += 1;
         let mut nev = nev0.clamp(1, self.cap);
         let outcome = loop {
-            let out =
-                self.kernel
-                    .largest(&*op.op, nev, self.params.tol, self.params.max_restarts)?;
+            let out = op.largest(self.kernel, nev, self.params.tol, self.params.max_restarts)?;
             if out.vectors.nrows() != dim || out.vectors.ncols() < out.theta.len() {
                 return Err(Error::Dimension {
                     context: format!(
@@ -197,7 +211,7 @@ impl<'a> BandRun<'a> {
             ));
             nev = grown;
         };
-        self.info.op_applications += op.op.applications();
+        self.info.op_applications += op.transform().applications();
         drop(op);
         let Some((out, lam)) = outcome else {
             let mid = 0.5 * (lo + hi);

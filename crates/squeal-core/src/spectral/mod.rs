@@ -29,6 +29,16 @@ pub trait LinOp<T>: Sync {
     fn apply(&self, x: &[T], y: &mut [T]);
 }
 
+/// A real operator seen on real vectors and on complex ones (applied to their real and
+/// imaginary parts), e.g. the squared transformation
+/// [`SquaredShift`].
+pub trait RealOp: Sync {
+    /// The operator on real vectors.
+    fn real(&self) -> &dyn LinOp<f64>;
+    /// The same operator on complex vectors.
+    fn complex(&self) -> &dyn LinOp<crate::c64>;
+}
+
 /// A spectral transformation `OP = (A - sigma B)^-1 B` of a pencil `(A, B)`: its shift,
 /// the map from an operator eigenvalue back to the pencil's, and its cost so far.
 pub trait SpectralTransform<T>: LinOp<T>

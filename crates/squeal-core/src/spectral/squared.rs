@@ -2,7 +2,7 @@
 //! is `(K - s M) u = 0` with `s = -lambda^2`, inverted at a real shift by a sparse LU or by
 //! the Woodbury identity on a symmetric factor ([`crate::lowrank::Woodbury`]).
 
-use super::{LinOp, SpectralTransform};
+use super::{LinOp, RealOp, SpectralTransform};
 use crate::linalg::{add_scaled, spmv_complex_split};
 use crate::lowrank::{SymmetricShift, Woodbury};
 use crate::operator::{check_qep, Qep};
@@ -118,6 +118,40 @@ impl SpectralTransform<c64> for SquaredShift<'_> {
     }
 }
 
+impl SquaredShift<'_> {
+    /// `B <- (K~ - sigma_s M~)^-1 B`.
+    fn solve_in_place(&self, b: MatMut<'_, f64>) {
+        match &self.solve {
+            ShiftedSolve::Lu(lu) => lu.solve_in_place(b),
+            ShiftedSolve::Woodbury(w) => w.solve_in_place(b),
+        }
+    }
+}
+
+impl RealOp for SquaredShift<'_> {
+    fn real(&self) -> &dyn LinOp<f64> {
+        self
+    }
+    fn complex(&self) -> &dyn LinOp<c64> {
+        self
+    }
+}
+
+impl LinOp<f64> for SquaredShift<'_> {
+    fn dim(&self) -> usize {
+        self.qep.dim()
+    }
+
+    fn apply(&self, x: &[f64], y: &mut [f64]) {
+        let n = self.qep.dim();
+        assert_eq!(x.len(), n, "SquaredShift::apply: x has the wrong length");
+        assert_eq!(y.len(), n, "SquaredShift::apply: y has the wrong length");
+        crate::linalg::spmv(self.qep.m.as_ref(), x, y);
+        self.solve_in_place(MatMut::from_column_major_slice_mut(y, n, 1));
+        self.applications.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
 impl LinOp<c64> for SquaredShift<'_> {
     fn dim(&self) -> usize {
         self.qep.dim()
@@ -128,10 +162,7 @@ impl LinOp<c64> for SquaredShift<'_> {
         assert_eq!(x.len(), n, "SquaredShift::apply: x has the wrong length");
         assert_eq!(y.len(), n, "SquaredShift::apply: y has the wrong length");
         let mut b = spmv_complex_split(self.qep.m.as_ref(), x);
-        match &self.solve {
-            ShiftedSolve::Lu(lu) => lu.solve_in_place(b.as_mut()),
-            ShiftedSolve::Woodbury(w) => w.solve_in_place(b.as_mut()),
-        }
+        self.solve_in_place(b.as_mut());
         for (i, v) in y.iter_mut().enumerate() {
             *v = c64::new(b[(i, 0)], b[(i, 1)]);
         }
