@@ -163,17 +163,6 @@ impl SymmetricShift {
         self.s_residual
     }
 
-    /// `B <- S(s)^-1 B` in one sweep of the factor for all columns, with `par` inside
-    /// the dense kernels.
-    pub fn solve_block_in_place(&self, b: MatMut<'_, f64>, par: Par) {
-        let n = self.dim();
-        let chol = &self.pencil.chol;
-        let perm = PermRef::new_checked(&self.perm_fwd, &self.perm_inv, n);
-        let lblt = IntranodeLbltRef::new(chol, &self.l_values, &self.subdiag, perm);
-        let mut mem = MemBuffer::new(chol.solve_in_place_scratch::<f64>(b.ncols(), par));
-        lblt.solve_in_place_with_conj(Conj::No, b, par, MemStack::new(&mut mem));
-    }
-
     /// `B <- S(s)^-1 B` (any number of columns).
     pub fn solve_in_place(&self, b: MatMut<'_, f64>) {
         let n = self.dim();
